@@ -1,0 +1,2 @@
+//! Relative-motion filter: linear Kalman filter on position, invariant EKF on attitude, motion compensation
+#![forbid(unsafe_code)]
