@@ -1,0 +1,2 @@
+//! Placeholder, replaced once the target crate builds.
+fn main() {}
