@@ -75,6 +75,7 @@ pub struct ScenarioConfig {
     pub frame_period_s: f64,
     /// `>= 1`: the chaser trajectory (and, for the ellipse, the orbit) runs
     /// this many times faster; the target's own rotation keeps its true rate.
+    /// Ignored by the random scenario (its frames are independent).
     pub compression: f64,
     /// Range of the target centre of mass (m), random scenario only.
     pub range_m: f64,

@@ -12,6 +12,32 @@
 //! - `random` — seed 002 §4.3: independent frames at a fixed range with
 //!   uniform 321 Euler angles.
 //!
+//! Figures (checked by the unit tests):
+//! - slow-spin: 15 m over [0, 550] s (figure-of-eight fly-around, azimuth
+//!   ±80°, elevation ±25°, then hold), 15 → 8 m over [550, 900] s, 8 m over
+//!   [900, 970] s, 8 → 3 m over [970, 1470] s. Approach legs start and stop
+//!   with 10 s cosine velocity ramps, so cruise is 2.06 and 1.02 cm/s.
+//! - tumbling: inertia `diag(1.2, 1, 1)`, symmetry (spin) axis = body x (the
+//!   roll axis), ω₀ = 10°/s along x + 1°/s along y, so `|ω| = 10.05°/s`.
+//!   Nutation (axis to H) `atan(1/12) = 4.76°`; the axis cones about H at
+//!   `Ω_p = |H|/I_t = √145 = 12.04°/s` (period 29.9 s) while ω turns in the
+//!   body at `λ = 0.2 ω_a = 2°/s`. H is tilted 5.24° from `y_LVLH`, so the
+//!   spin axis swings between 0.47° and 10.0° from `y_LVLH`. Legs: fly-around
+//!   to 350 s, 15 → 8 m to 700 s, hold, 8 → 4 m over [750, 1150] s, hold,
+//!   4 → 3 m over [1230, 1330] s, hold to 1380 s.
+//! - ellipse: Hill amplitudes 25 m radial, 50 m along-track, 17.6 m
+//!   cross-track (n = 2π/6000 s): range 25.0-53.0 m; target at 2°/s about
+//!   body (0.48, −0.6, 0.64) from a seeded uniform attitude, inertial rate
+//!   (LVLH rotates at n); 241 frames at 50 s.
+//! - random: range exactly `range_m`, centre of mass off the boresight by up
+//!   to ±1° per axis; yaw, pitch, roll uniform in the open intervals.
+//! - pointing error: 0.3° per axis, sinusoids with seeded periods in
+//!   [90, 180] s (true clock), at most 0.42° off the boresight.
+//!
+//! `v` and `ω` are analytic (chaser velocity, look-at rate, pointing-error
+//! rate through the right Jacobian, closed-form body rates); the tests hold
+//! them to five-point finite differences of the pose within 1e-7 relative.
+//!
 //! The sensor rides on the chaser; its boresight (sensor `z`) looks at the
 //! target centre of mass up to a smooth pointing error of a few tenths of a
 //! degree, and its `y` axis leans towards a fixed LVLH direction. Frames and
