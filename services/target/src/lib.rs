@@ -1,2 +1,25 @@
-//! Target spacecraft models: meshes, built-in targets, materials, symmetries, surface sampling and BVH ray casting
+//! Target spacecraft models: meshes, built-in targets, materials, symmetries, surface sampling
+//! and BVH ray casting.
+//!
+//! A [`Target`] holds a triangle [`Mesh`] in the target body frame (origin at the centre of
+//! mass), one [`Material`] per [`MaterialId`] used by its faces, and its symmetry group (the
+//! rotations `S_k` with `Q ≡ Q S_k`, seed 004 Eq. (14)). Built-in targets: ENVISAT (seed 002
+//! §3.1) and a DEOS-like client (seed 004 §III.C.4). Other targets load from STL, OBJ or PLY.
 #![forbid(unsafe_code)]
+
+pub mod builtin;
+mod error;
+mod loaders;
+pub mod material;
+mod mesh;
+pub mod sampling;
+mod shapes;
+mod target;
+
+pub use error::TargetError;
+pub use material::{Material, MaterialClass, MaterialId};
+pub use mesh::{Mesh, RayHit};
+pub use target::Target;
+
+#[cfg(test)]
+mod ray_cost_tests;
