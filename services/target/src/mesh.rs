@@ -236,6 +236,10 @@ impl Mesh {
     /// mesh (both sides of every triangle are hit). `dir_unit` is normalised here in case it
     /// is not exactly unit; the distance is along the unit direction. Returns `None` on a
     /// miss and for a non-finite origin, a zero or non-finite direction, or `max_range <= 0`.
+    ///
+    /// A ray that starts on the surface (e.g. a reflected ray) may hit its own face at a
+    /// distance ≈ 0: move its origin off the surface first (about 1e-4 of the mesh size
+    /// along the returned normal is plenty for the `f32` BVH).
     #[inline]
     pub fn cast_ray(
         &self,
