@@ -24,7 +24,11 @@ impl Euler321 {
 
     /// Angles given in degrees.
     pub fn from_degrees(yaw_deg: f64, pitch_deg: f64, roll_deg: f64) -> Self {
-        Self::new(yaw_deg.to_radians(), pitch_deg.to_radians(), roll_deg.to_radians())
+        Self::new(
+            yaw_deg.to_radians(),
+            pitch_deg.to_radians(),
+            roll_deg.to_radians(),
+        )
     }
 
     /// `R = R_z(ψ) R_y(θ) R_x(φ)`.
@@ -52,7 +56,11 @@ impl Euler321 {
 
     /// The angles in degrees as `[yaw, pitch, roll]`.
     pub fn to_degrees(&self) -> [f64; 3] {
-        [self.yaw.to_degrees(), self.pitch.to_degrees(), self.roll.to_degrees()]
+        [
+            self.yaw.to_degrees(),
+            self.pitch.to_degrees(),
+            self.roll.to_degrees(),
+        ]
     }
 }
 
@@ -62,7 +70,12 @@ mod tests {
 
     #[test]
     fn round_trip_away_from_gimbal_lock() {
-        for &(y, p, r) in &[(10.0, 20.0, 30.0), (-170.0, -80.0, 179.0), (0.0, 0.0, 0.0), (95.0, 45.0, -135.0)] {
+        for &(y, p, r) in &[
+            (10.0, 20.0, 30.0),
+            (-170.0, -80.0, 179.0),
+            (0.0, 0.0, 0.0),
+            (95.0, 45.0, -135.0),
+        ] {
             let e = Euler321::from_degrees(y, p, r);
             let back = Euler321::from_rotation(&e.to_rotation());
             let [yb, pb, rb] = back.to_degrees();

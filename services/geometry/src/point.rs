@@ -27,12 +27,24 @@ pub struct Point {
 impl Point {
     /// A point at `(x, y, z)` with intensity and timestamp.
     pub fn new(x: f32, y: f32, z: f32, intensity: f32, t: f64) -> Self {
-        Self { x, y, z, intensity, t }
+        Self {
+            x,
+            y,
+            z,
+            intensity,
+            t,
+        }
     }
 
     /// A point from a double-precision position.
     pub fn from_vector(v: &Vector3<f64>, intensity: f32, t: f64) -> Self {
-        Self { x: v.x as f32, y: v.y as f32, z: v.z as f32, intensity, t }
+        Self {
+            x: v.x as f32,
+            y: v.y as f32,
+            z: v.z as f32,
+            intensity,
+            t,
+        }
     }
 
     /// The position in double precision.

@@ -25,12 +25,18 @@ impl Default for Pose {
 impl Pose {
     /// The identity transform.
     pub fn identity() -> Self {
-        Self { rotation: Rotation3::identity(), translation: Vector3::zeros() }
+        Self {
+            rotation: Rotation3::identity(),
+            translation: Vector3::zeros(),
+        }
     }
 
     /// A transform from its rotation and translation.
     pub fn new(rotation: Rotation3<f64>, translation: Vector3<f64>) -> Self {
-        Self { rotation, translation }
+        Self {
+            rotation,
+            translation,
+        }
     }
 
     /// `T(z) = R z + p`.
@@ -42,7 +48,10 @@ impl Pose {
     /// `T⁻¹`.
     pub fn inverse(&self) -> Self {
         let r_inv = self.rotation.inverse();
-        Self { rotation: r_inv, translation: -(r_inv * self.translation) }
+        Self {
+            rotation: r_inv,
+            translation: -(r_inv * self.translation),
+        }
     }
 
     /// `self ∘ other`: apply `other` first, then `self`.
@@ -61,7 +70,10 @@ impl Pose {
         let rotation = so3::exp(&dr) * self.rotation;
         // Re-orthonormalise so thousands of increments never drift off SO(3).
         let rotation = Rotation3::from_matrix_eps(rotation.matrix(), 1e-12, 4, rotation);
-        Self { rotation, translation: self.translation + dp }
+        Self {
+            rotation,
+            translation: self.translation + dp,
+        }
     }
 
     /// The inverse of [`Pose::oplus`]: the `δ` with `δ ⊕ other = self`.
@@ -78,7 +90,8 @@ impl Pose {
         let rz = self.rotation * z;
         let mut j = Matrix3x6::zeros();
         j.fixed_view_mut::<3, 3>(0, 0).copy_from(&(-so3::hat(&rz)));
-        j.fixed_view_mut::<3, 3>(0, 3).copy_from(&Matrix3::identity());
+        j.fixed_view_mut::<3, 3>(0, 3)
+            .copy_from(&Matrix3::identity());
         j
     }
 
@@ -102,7 +115,10 @@ mod tests {
     use super::*;
 
     fn sample_pose() -> Pose {
-        Pose::new(so3::exp(&Vector3::new(0.4, -1.1, 0.7)), Vector3::new(1.0, -2.0, 9.0))
+        Pose::new(
+            so3::exp(&Vector3::new(0.4, -1.1, 0.7)),
+            Vector3::new(1.0, -2.0, 9.0),
+        )
     }
 
     #[test]

@@ -155,12 +155,26 @@ mod tests {
     #[test]
     fn exp_log_round_trip_near_zero_and_near_pi() {
         let mut rng = ChaCha8Rng::seed_from_u64(2);
-        for &angle in &[0.0, 1e-12, 1e-8, 1e-6, 1e-3, 0.5, 2.0, PI - 1e-3, PI - 1e-6, PI - 1e-9] {
+        for &angle in &[
+            0.0,
+            1e-12,
+            1e-8,
+            1e-6,
+            1e-3,
+            0.5,
+            2.0,
+            PI - 1e-3,
+            PI - 1e-6,
+            PI - 1e-9,
+        ] {
             for _ in 0..20 {
                 let axis = random_vector(&mut rng, 1.0).normalize();
                 let v = axis * angle;
                 let back = log(&exp(&v));
-                assert!((back - v).norm() < 1e-9 * (1.0 + angle), "angle {angle}: {v:?} -> {back:?}");
+                assert!(
+                    (back - v).norm() < 1e-9 * (1.0 + angle),
+                    "angle {angle}: {v:?} -> {back:?}"
+                );
             }
         }
         // Exactly π: the axis is recovered up to sign.
