@@ -11,11 +11,19 @@
 //! - The lidar frame has `z` along the boresight, `x` right, `y` down.
 #![forbid(unsafe_code)]
 
+pub mod centroid;
+pub mod error;
 pub mod euler;
+pub mod io;
 pub mod point;
 pub mod pose;
 pub mod so3;
+pub mod voxel;
 
+pub use centroid::{DEFAULT_TRIM, HasPosition, centroid, trimmed_centroid};
+pub use error::GeometryError;
 pub use euler::Euler321;
+pub use io::{CloudFormat, read_cloud, write_cloud};
 pub use point::Point;
 pub use pose::Pose;
+pub use voxel::{VoxelFilter, VoxelOutput, voxel_filter};
