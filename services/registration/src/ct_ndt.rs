@@ -1,0 +1,210 @@
+//! Continuous-time smoothed NDT, seed 000 §3.3: the end pose `T^e` of a scan
+//! is optimised with the start pose `T^s` fixed, each point being mapped by
+//! the pose interpolated at its timestamp (Eq. 13-14), with the Jacobian of
+//! Eq. (15) (Appendix A.2).
+
+use crate::error::RegistrationError;
+use crate::gauss_newton;
+use crate::ndt_map::NdtMap;
+use crate::normal_equations::NormalEquations;
+use crate::params::NdtParams;
+use crate::result::Registration;
+use crate::source::{check_pose, position_is_finite};
+use nalgebra::{Matrix3, Matrix3x6, Vector3};
+use spacepose_geometry::{Point, Pose, so3};
+
+/// Start and end times of a scan on the sensor clock (s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScanTimes {
+    /// `t^s`, time of the start pose.
+    pub start_s: f64,
+    /// `t^e`, time of the end pose (must be later than `start_s`).
+    pub end_s: f64,
+}
+
+impl ScanTimes {
+    /// Rejects non-finite times and an empty or reversed interval.
+    pub fn validate(&self) -> Result<(), RegistrationError> {
+        if self.start_s.is_finite() && self.end_s.is_finite() && self.end_s > self.start_s {
+            Ok(())
+        } else {
+            Err(RegistrationError::param(
+                "scan_times",
+                format!(
+                    "need finite start < end, got [{}, {}]",
+                    self.start_s, self.end_s
+                ),
+            ))
+        }
+    }
+
+    /// Interpolation factor `u = (t - t^s) / (t^e - t^s)` (Eq. 13).
+    pub fn factor(&self, t_s: f64) -> f64 {
+        (t_s - self.start_s) / (self.end_s - self.start_s)
+    }
+}
+
+/// `interp(T^s, T^e, u)` of Eq. (13): linear in position, slerp in attitude,
+/// `R^u = Exp(u Log(R^e (R^s)⁻¹)) R^s`. `u` outside `[0, 1]` extrapolates at
+/// constant velocity.
+pub fn interpolate(start: &Pose, end: &Pose, u: f64) -> Pose {
+    let phi = so3::log(&(end.rotation * start.rotation.inverse()));
+    Pose::new(
+        so3::exp(&(phi * u)) * start.rotation,
+        start.translation * (1.0 - u) + end.translation * u,
+    )
+}
+
+/// `Exp(x)` and `D_exp(x)` (seed 000 Eq. 4 and A4) from one `sin_cos`:
+/// `Exp = I + a K + b K²`, `D_exp = I + b K + c K²` with `K = x^×`,
+/// `a = sin θ/θ`, `b = (1 - cos θ)/θ²`, `c = (θ - sin θ)/θ³`.
+#[inline]
+fn exp_and_d_exp(x: &Vector3<f64>) -> (Matrix3<f64>, Matrix3<f64>) {
+    let theta2 = x.norm_squared();
+    let (a, b, c) = if theta2 < 1e-10 {
+        (
+            1.0 - theta2 / 6.0,
+            0.5 - theta2 / 24.0,
+            1.0 / 6.0 - theta2 / 120.0,
+        )
+    } else {
+        let theta = theta2.sqrt();
+        let (s, co) = theta.sin_cos();
+        (
+            s / theta,
+            (1.0 - co) / theta2,
+            (theta - s) / (theta2 * theta),
+        )
+    };
+    let k = so3::hat(x);
+    let k2 = k * k;
+    let id = Matrix3::identity();
+    (id + k * a + k2 * b, id + k * b + k2 * c)
+}
+
+/// What every point shares within one linearisation at `T^e`.
+struct Interpolation {
+    r_start: Matrix3<f64>,
+    p_start: Vector3<f64>,
+    p_end: Vector3<f64>,
+    /// `Log Q`, `Q = R^e (R^s)⁻¹`.
+    phi: Vector3<f64>,
+    /// `D_log(Q)`.
+    d_log_q: Matrix3<f64>,
+}
+
+impl Interpolation {
+    fn new(start: &Pose, end: &Pose) -> Self {
+        let phi = so3::log(&(end.rotation * start.rotation.inverse()));
+        Self {
+            r_start: *start.rotation.matrix(),
+            p_start: start.translation,
+            p_end: end.translation,
+            phi,
+            d_log_q: so3::d_exp_inv(&phi),
+        }
+    }
+
+    /// `(R^u z, T_u(z), D_exp(u Log Q))` for one point.
+    #[inline]
+    fn apply(&self, z: &Vector3<f64>, u: f64) -> (Vector3<f64>, Vector3<f64>, Matrix3<f64>) {
+        let (exp_u, d_exp_u) = exp_and_d_exp(&(self.phi * u));
+        let rz = exp_u * (self.r_start * z);
+        let x = rz + self.p_start * (1.0 - u) + self.p_end * u;
+        (rz, x, d_exp_u)
+    }
+
+    /// Rotation block of Eq. (15): `-(R^u z)^× u D_exp(u Log Q) D_log(Q)`.
+    #[inline]
+    fn rotation_block(&self, rz: &Vector3<f64>, d_exp_u: &Matrix3<f64>, u: f64) -> Matrix3<f64> {
+        -so3::hat(rz) * (d_exp_u * self.d_log_q) * u
+    }
+}
+
+/// The Jacobian of Eq. (15), `D interp(T^s, T^e, u)(z) / D T^e`, for the left
+/// perturbation `δ ⊕ T^e`, `δ = [rot; trans]`.
+pub fn ct_point_jacobian(start: &Pose, end: &Pose, u: f64, z: &Vector3<f64>) -> Matrix3x6<f64> {
+    let interp = Interpolation::new(start, end);
+    let (rz, _, d_exp_u) = interp.apply(z, u);
+    let mut j = Matrix3x6::zeros();
+    j.fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(&interp.rotation_block(&rz, &d_exp_u, u));
+    j.fixed_view_mut::<3, 3>(0, 3)
+        .copy_from(&(Matrix3::identity() * u));
+    j
+}
+
+/// Normal equations of Eq. (14) at end pose `end`.
+fn linearise(
+    map: &NdtMap,
+    points: &[(Vector3<f64>, f64)],
+    start: &Pose,
+    end: &Pose,
+    params: &NdtParams,
+) -> NormalEquations {
+    let interp = Interpolation::new(start, end);
+    let mut ne = NormalEquations::new();
+    for (z, u) in points {
+        let (rz, x, d_exp_u) = interp.apply(z, *u);
+        if let Some((k, _)) = map.nearest_cell(&x, params.max_distance_m, params.lookup) {
+            let (mean, information) = map.mean_and_information(k);
+            ne.add(
+                &interp.rotation_block(&rz, &d_exp_u, *u),
+                *u,
+                information,
+                &(x - mean),
+            );
+        }
+    }
+    ne
+}
+
+/// Continuous-time NDT: registers a scan whose points carry timestamps
+/// within `scan`, optimising the end pose `T^e = t_target_sensor` at
+/// `scan.end_s` with the start pose `t_target_sensor_start` (at
+/// `scan.start_s`, typically the previous result) fixed (Eq. 14).
+///
+/// Same loop, termination and result as [`crate::register_ndt`]; the
+/// returned pose and information refer to `T^e`. Points whose position or
+/// timestamp is not finite are skipped and counted. Timestamps outside the
+/// interval extrapolate the constant-velocity motion.
+///
+/// Errors: those of [`crate::register_ndt`], plus an invalid `scan` or a
+/// non-finite start pose.
+pub fn register_ct_ndt(
+    map: &NdtMap,
+    source: &[Point],
+    scan: &ScanTimes,
+    t_target_sensor_start: &Pose,
+    initial_t_target_sensor_end: &Pose,
+    params: &NdtParams,
+) -> Result<Registration, RegistrationError> {
+    params.validate()?;
+    scan.validate()?;
+    check_pose("t_target_sensor_start", t_target_sensor_start)?;
+    check_pose("initial_t_target_sensor_end", initial_t_target_sensor_end)?;
+    if source.is_empty() {
+        return Err(RegistrationError::EmptyCloud);
+    }
+    let points: Vec<(Vector3<f64>, f64)> = source
+        .iter()
+        .filter(|p| position_is_finite(p) && p.t.is_finite())
+        .map(|p| (p.position(), scan.factor(p.t)))
+        .collect();
+    if points.is_empty() {
+        return Err(RegistrationError::AllPointsNonFinite {
+            count: source.len(),
+        });
+    }
+    let skipped = source.len() - points.len();
+    gauss_newton::run(
+        *initial_t_target_sensor_end,
+        params,
+        points.len(),
+        skipped,
+        |end| linearise(map, &points, t_target_sensor_start, end, params),
+    )
+}
+
+#[cfg(test)]
+mod tests;

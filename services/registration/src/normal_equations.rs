@@ -1,0 +1,156 @@
+//! Accumulation and solution of the Gauss-Newton normal equations, seed 000
+//! Eq. (7), for Jacobians of the form `J = [A  s·I₃]` (Eq. 6 and Eq. 15).
+
+use crate::error::RegistrationError;
+use crate::result::Increment;
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+
+/// `Σ JᵀPJ`, `Σ JᵀPr`, `Σ rᵀPr` and `Σ |r|²` over the inliers, kept as
+/// 3×3 blocks so no 6×6 product is formed per point.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct NormalEquations {
+    h_rr: Matrix3<f64>,
+    h_rt: Matrix3<f64>,
+    h_tt: Matrix3<f64>,
+    g_r: Vector3<f64>,
+    g_t: Vector3<f64>,
+    /// `Σ rᵀ P r`.
+    pub cost: f64,
+    /// `Σ |r|²`.
+    pub squared_distance: f64,
+    /// Number of terms added.
+    pub inliers: usize,
+}
+
+impl NormalEquations {
+    pub(crate) fn new() -> Self {
+        Self {
+            h_rr: Matrix3::zeros(),
+            h_rt: Matrix3::zeros(),
+            h_tt: Matrix3::zeros(),
+            g_r: Vector3::zeros(),
+            g_t: Vector3::zeros(),
+            cost: 0.0,
+            squared_distance: 0.0,
+            inliers: 0,
+        }
+    }
+
+    /// Adds the term of residual `r = T(z) - μ` with information `P` and
+    /// Jacobian `J = [a  s·I₃]` (`a` the 3×3 rotation block).
+    #[inline(always)]
+    pub(crate) fn add(&mut self, a: &Matrix3<f64>, s: f64, p: &Matrix3<f64>, r: &Vector3<f64>) {
+        let pa = p * a;
+        let pr = p * r;
+        self.h_rr += a.tr_mul(&pa);
+        self.h_rt += pa.transpose() * s;
+        self.h_tt += p * (s * s);
+        self.g_r += a.tr_mul(&pr);
+        self.g_t += pr * s;
+        self.cost += r.dot(&pr);
+        self.squared_distance += r.norm_squared();
+        self.inliers += 1;
+    }
+
+    /// Adds a rigid term, `J = [-(R z)^×  I₃]` (Eq. 6), with `rz = R z`.
+    #[inline(always)]
+    pub(crate) fn add_rigid(&mut self, rz: &Vector3<f64>, p: &Matrix3<f64>, r: &Vector3<f64>) {
+        let a = Matrix3::new(0.0, rz.z, -rz.y, -rz.z, 0.0, rz.x, rz.y, -rz.x, 0.0);
+        self.add(&a, 1.0, p, r);
+    }
+
+    /// `H = Σ JᵀPJ`, the information matrix in the `δ = [rot; trans]` order.
+    pub(crate) fn hessian(&self) -> Matrix6<f64> {
+        let mut h = Matrix6::zeros();
+        h.fixed_view_mut::<3, 3>(0, 0).copy_from(&self.h_rr);
+        h.fixed_view_mut::<3, 3>(0, 3).copy_from(&self.h_rt);
+        h.fixed_view_mut::<3, 3>(3, 0)
+            .copy_from(&self.h_rt.transpose());
+        h.fixed_view_mut::<3, 3>(3, 3).copy_from(&self.h_tt);
+        h
+    }
+
+    /// Solves Eq. (7), `H ε = -g`, by Cholesky. Fails when `H` is not
+    /// (numerically) positive definite: a pivot below `1e-12 · max Hᵢᵢ`.
+    pub(crate) fn solve(&self, iteration: usize) -> Result<Vector6<f64>, RegistrationError> {
+        let degenerate = RegistrationError::DegenerateSystem {
+            iteration,
+            inliers: self.inliers,
+        };
+        let h = self.hessian();
+        let g = Vector6::new(
+            self.g_r.x, self.g_r.y, self.g_r.z, self.g_t.x, self.g_t.y, self.g_t.z,
+        );
+        let scale = h.diagonal().max();
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(degenerate);
+        }
+        let chol = h.cholesky().ok_or(degenerate)?;
+        let l = chol.l_dirty();
+        if (0..6).any(|i| l[(i, i)] * l[(i, i)] <= 1e-12 * scale) {
+            return Err(RegistrationError::DegenerateSystem {
+                iteration,
+                inliers: self.inliers,
+            });
+        }
+        let eps = -chol.solve(&g);
+        if eps.iter().all(|v| v.is_finite()) {
+            Ok(eps)
+        } else {
+            Err(RegistrationError::DegenerateSystem {
+                iteration,
+                inliers: self.inliers,
+            })
+        }
+    }
+}
+
+/// Sizes of an increment `ε = [rot; trans]`.
+pub(crate) fn increment_of(eps: &Vector6<f64>) -> Increment {
+    Increment {
+        rotation_rad: eps.fixed_rows::<3>(0).norm(),
+        translation_m: eps.fixed_rows::<3>(3).norm(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Matrix3x6;
+    use spacepose_geometry::{Pose, so3};
+
+    #[test]
+    fn block_accumulation_matches_dense_products() {
+        let t = Pose::new(
+            so3::exp(&Vector3::new(0.3, -0.2, 0.9)),
+            Vector3::new(1.0, 2.0, -3.0),
+        );
+        let z = Vector3::new(0.4, -1.3, 2.2);
+        let p = Matrix3::new(4.0, 1.0, 0.5, 1.0, 3.0, -0.2, 0.5, -0.2, 2.0);
+        let r = Vector3::new(0.01, -0.02, 0.03);
+        let mut ne = NormalEquations::new();
+        ne.add_rigid(&(t.rotation * z), &p, &r);
+        let j: Matrix3x6<f64> = t.point_jacobian(&z);
+        let h = j.transpose() * p * j;
+        assert!((ne.hessian() - h).norm() < 1e-12);
+        let g = j.transpose() * p * r;
+        assert!((ne.g_r - g.fixed_rows::<3>(0)).norm() < 1e-14);
+        assert!((ne.g_t - g.fixed_rows::<3>(3)).norm() < 1e-14);
+        assert!((ne.cost - r.dot(&(p * r))).abs() < 1e-15);
+    }
+
+    #[test]
+    fn rank_deficient_system_is_an_error() {
+        let mut ne = NormalEquations::new();
+        // A single point constrains only three directions.
+        ne.add_rigid(
+            &Vector3::new(1.0, 0.0, 0.0),
+            &Matrix3::identity(),
+            &Vector3::zeros(),
+        );
+        assert!(matches!(
+            ne.solve(0),
+            Err(RegistrationError::DegenerateSystem { .. })
+        ));
+    }
+}
