@@ -1,0 +1,8 @@
+//! Evaluations against the simulator's ground truth. Truth only scores: it
+//! never reaches an estimator, except the documented truth initialisation of
+//! the tracker at the first frame (acquisition comes in a later issue).
+
+pub mod plot;
+pub mod stats;
+pub mod table;
+pub mod tracking;

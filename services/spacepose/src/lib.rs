@@ -1,0 +1,9 @@
+//! The spacepose command line as a library: each sub-command is a module
+//! with a `run` function, so tests can call it without spawning a process.
+#![forbid(unsafe_code)]
+
+pub mod cli;
+pub mod common;
+pub mod eval;
+pub mod sim_cmd;
+pub mod truth_csv;

@@ -1,0 +1,34 @@
+//! `spacepose`: the command line of the spacepose suite.
+//!
+//! Errors are printed as one line (`error: …` with the chain of causes) and
+//! exit with status 2; nothing panics on bad input.
+
+use clap::Parser;
+use spacepose::cli::{Cli, Command, EvalCommand};
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    init_logging(cli.verbose);
+    let result = match cli.command {
+        Command::Sim(args) => spacepose::sim_cmd::run(&args),
+        Command::Eval(EvalCommand::Tracking(args)) => spacepose::eval::tracking::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn init_logging(verbose: bool) {
+    let default = if verbose { "info" } else { "warn" };
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(default));
+    tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .init();
+}

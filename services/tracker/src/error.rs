@@ -1,0 +1,39 @@
+//! Errors of the tracking loop.
+
+use spacepose_filter::FilterError;
+use spacepose_geometry::GeometryError;
+use spacepose_registration::RegistrationError;
+use thiserror::Error;
+
+/// Why a frame could not be tracked, or a tracker could not be built.
+#[derive(Debug, Error)]
+pub enum TrackError {
+    /// A configuration value is invalid (NaN, out of range).
+    #[error("invalid tracker configuration: {0}")]
+    InvalidConfig(String),
+    /// `process` was called before `initialize`, or after the track was
+    /// lost without re-initialisation.
+    #[error("tracker is not initialised (no pose to start from)")]
+    NotInitialized,
+    /// The frame's scan times are not finite, out of order, or not after
+    /// the previous frame.
+    #[error("invalid scan times: start {start_s}, end {end_s} (previous end {previous_end_s:?})")]
+    InvalidScanTimes {
+        /// Scan start (s).
+        start_s: f64,
+        /// Scan end (s).
+        end_s: f64,
+        /// End of the previous processed frame (s), if any.
+        previous_end_s: Option<f64>,
+    },
+    /// The voxel filter rejected the frame.
+    #[error("pre-processing failed: {0}")]
+    Preprocess(#[from] GeometryError),
+    /// The registration failed (empty cloud, all NaN, no correspondence,
+    /// degenerate geometry).
+    #[error("registration failed: {0}")]
+    Registration(#[from] RegistrationError),
+    /// The filter rejected an input (non-finite pose, bad time step).
+    #[error("filter failed: {0}")]
+    Filter(#[from] FilterError),
+}

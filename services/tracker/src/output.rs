@@ -1,0 +1,59 @@
+//! What the tracker returns for every frame.
+
+use crate::status::TrackStatus;
+use nalgebra::{Matrix6, Vector3};
+use spacepose_geometry::Pose;
+use spacepose_registration::Registration;
+
+/// Wall-clock time spent on a frame (ms, one thread).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Timings {
+    /// Motion compensation and voxel filter.
+    pub preprocess_ms: f64,
+    /// Registration.
+    pub registration_ms: f64,
+    /// Whole frame: pre-processing, registration and filter update. This is
+    /// the "execution time" of seed 000 Tables 2-3 (voxel filter included).
+    pub total_ms: f64,
+}
+
+/// The tracker's answer for one frame.
+#[derive(Debug, Clone)]
+pub struct TrackOutput {
+    /// Scan end time: the time the pose refers to (s).
+    pub t: f64,
+    /// Estimated `t_sensor_target` at scan end. For a lost frame, the
+    /// filter prediction (flagged by `status`).
+    pub t_sensor_target: Pose,
+    /// Covariance of `t_sensor_target` (left ⊕, `[rot; trans]`), from the
+    /// registration information; `None` when degenerate or lost.
+    pub covariance: Option<Matrix6<f64>>,
+    /// Track health after this frame.
+    pub status: TrackStatus,
+    /// Why the frame is degraded or lost (empty when tracking).
+    pub reason: String,
+    /// The registration's full result, when it ran to completion.
+    pub registration: Option<Registration>,
+    /// Attitude difference between the measurement and the filter
+    /// prediction (deg); NaN without a measurement.
+    pub innovation_rot_deg: f64,
+    /// Position difference between the measurement and the prediction (m).
+    pub innovation_pos_m: f64,
+    /// Filter's angular velocity after the frame, target frame (rad/s).
+    pub w_target: Vector3<f64>,
+    /// Filter's velocity after the frame, sensor frame (m/s).
+    pub v_sensor: Vector3<f64>,
+    /// Points received.
+    pub points_in: usize,
+    /// Points after pre-processing (what the registration saw).
+    pub points_used: usize,
+    /// Time spent.
+    pub timings: Timings,
+}
+
+impl TrackOutput {
+    /// Registration iterations (0 when none ran).
+    pub fn iterations(&self) -> usize {
+        self.registration.as_ref().map_or(0, |r| r.iterations)
+    }
+}

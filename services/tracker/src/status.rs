@@ -1,0 +1,37 @@
+//! Track status, reported with every frame.
+
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// The health of the track after a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TrackStatus {
+    /// The registration converged with good quality and agrees with the
+    /// filter prediction.
+    Tracking,
+    /// A pose was produced but its quality is doubtful (no convergence, few
+    /// inliers, high cost, or disagreement with the prediction). The pose is
+    /// published but not fused into the filter.
+    Degraded,
+    /// The registration failed, or too many degraded frames in a row: the
+    /// track must be re-acquired ([`crate::Tracker::initialize`]).
+    Lost,
+}
+
+impl TrackStatus {
+    /// Lower-case name used in logs, JSON and telemetry.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Tracking => "tracking",
+            Self::Degraded => "degraded",
+            Self::Lost => "lost",
+        }
+    }
+}
+
+impl fmt::Display for TrackStatus {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}

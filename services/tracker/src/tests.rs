@@ -1,0 +1,76 @@
+//! Tracking-loop tests on the registration crate's deterministic synthetic
+//! spacecraft (motion-blurred frames with known truth).
+
+use crate::{TrackError, TrackStatus, Tracker, TrackerConfig, TrackingMode, TrackingModel};
+use nalgebra::Vector3;
+use spacepose_geometry::{Point, Pose, so3};
+use spacepose_registration::NdtMapParams;
+use spacepose_registration::synthetic::SyntheticTarget;
+use std::sync::OnceLock;
+
+fn fixture() -> &'static (SyntheticTarget, TrackingModel) {
+    static F: OnceLock<(SyntheticTarget, TrackingModel)> = OnceLock::new();
+    F.get_or_init(|| {
+        let target = SyntheticTarget::spacecraft(0.01);
+        let model = TrackingModel::build(&target.model(), &NdtMapParams::default()).unwrap();
+        (target, model)
+    })
+}
+
+/// Truth `t_sensor_target` at time `t`: 8 m ahead, spinning at `rate_degps`
+/// about a tilted body axis, drifting slowly towards the sensor.
+fn truth(t: f64, rate_degps: f64) -> Pose {
+    let axis = Vector3::new(0.2, 1.0, 0.1).normalize();
+    let r0 = so3::exp(&Vector3::new(0.3, -0.4, 0.2));
+    Pose::new(
+        r0 * so3::exp(&(axis * rate_degps.to_radians() * t)),
+        Vector3::new(0.1, -0.2, 8.0 - 0.02 * t),
+    )
+}
+
+#[test]
+fn bad_frames_are_reported_lost_not_panicking() {
+    let (_, model) = fixture();
+    let bad_frames: [Vec<Point>; 3] = [
+        vec![],
+        vec![Point::new(f32::NAN, f32::NAN, f32::NAN, 0.0, 0.5); 500],
+        (0..500)
+            .map(|i| Point::new(50.0 + i as f32 * 0.01, 40.0, 90.0, 1.0, 0.5))
+            .collect(),
+    ];
+    for cloud in bad_frames {
+        for mode in TrackingMode::ALL {
+            let mut tracker = Tracker::new(TrackerConfig::with_mode(mode), model.clone()).unwrap();
+            tracker
+                .initialize(0.0, &truth(0.0, 1.0), Vector3::zeros(), Vector3::zeros())
+                .unwrap();
+            let out = tracker.process(&cloud, 0.0, 1.0).unwrap();
+            assert_eq!(out.status, TrackStatus::Lost, "{mode}: {}", out.reason);
+            assert!(!out.reason.is_empty());
+            // Lost is sticky until re-initialisation.
+            let again = tracker.process(&cloud, 1.0, 2.0).unwrap();
+            assert_eq!(again.status, TrackStatus::Lost);
+        }
+    }
+}
+
+#[test]
+fn misuse_is_an_error() {
+    let (_, model) = fixture();
+    let mut tracker = Tracker::new(TrackerConfig::default(), model.clone()).unwrap();
+    assert!(matches!(
+        tracker.process(&[], 0.0, 1.0),
+        Err(TrackError::NotInitialized)
+    ));
+    tracker
+        .initialize(5.0, &truth(0.0, 1.0), Vector3::zeros(), Vector3::zeros())
+        .unwrap();
+    assert!(matches!(
+        tracker.process(&[], 4.0, 5.0),
+        Err(TrackError::InvalidScanTimes { .. })
+    ));
+    assert!(matches!(
+        tracker.process(&[], f64::NAN, 6.0),
+        Err(TrackError::InvalidScanTimes { .. })
+    ));
+}

@@ -1,0 +1,357 @@
+//! The tracking loop (seed 000 Fig. 2-4).
+
+use crate::config::TrackerConfig;
+use crate::error::TrackError;
+use crate::measurement::covariance_sensor_target;
+use crate::mode::TrackingMode;
+use crate::model::TrackingModel;
+use crate::output::{Timings, TrackOutput};
+use crate::status::TrackStatus;
+use nalgebra::Vector3;
+use spacepose_filter::{MotionCompensation, Prediction, RelativeMotionFilter};
+use spacepose_geometry::{Point, Pose, VoxelFilter, so3};
+use spacepose_registration::{
+    Registration, ScanTimes, register_ct_ndt, register_icp, register_ndt,
+};
+use std::time::Instant;
+
+/// The last pose the tracker produced.
+#[derive(Debug, Clone, Copy)]
+struct LastPose {
+    t: f64,
+    t_sensor_target: Pose,
+}
+
+/// Follows the target frame after frame. Not thread-safe by design: one
+/// tracker per stream of frames.
+pub struct Tracker {
+    config: TrackerConfig,
+    model: TrackingModel,
+    filter: RelativeMotionFilter,
+    voxel: VoxelFilter,
+    last: Option<LastPose>,
+    lost: bool,
+    consecutive_degraded: u32,
+}
+
+impl Tracker {
+    /// A tracker for `model`, not yet initialised.
+    pub fn new(config: TrackerConfig, model: TrackingModel) -> Result<Self, TrackError> {
+        config.validate()?;
+        let filter = RelativeMotionFilter::new(config.filter.clone())?;
+        let voxel = VoxelFilter::new(config.voxel_leaf_m)?;
+        Ok(Self {
+            config,
+            model,
+            filter,
+            voxel,
+            last: None,
+            lost: false,
+            consecutive_degraded: 0,
+        })
+    }
+
+    /// The configuration in force.
+    pub fn config(&self) -> &TrackerConfig {
+        &self.config
+    }
+
+    /// The current mode.
+    pub fn mode(&self) -> TrackingMode {
+        self.config.mode
+    }
+
+    /// Changes the mode between two frames; the filter state is kept.
+    pub fn set_mode(&mut self, mode: TrackingMode) {
+        self.config.mode = mode;
+    }
+
+    /// True once initialised and not lost.
+    pub fn is_tracking(&self) -> bool {
+        self.last.is_some() && !self.lost
+    }
+
+    /// The filter prediction at `t` (for seeding other estimators).
+    pub fn predict_at(&self, t: f64) -> Result<Prediction, TrackError> {
+        Ok(self.filter.predict_at(t)?)
+    }
+
+    /// (Re)starts tracking from `t_sensor_target` at time `t` (truth before
+    /// acquisition exists, an acquisition result afterwards). Unknown rates
+    /// are passed as zeros: the filter starts at ω = 0 (seed 000 §5.2).
+    pub fn initialize(
+        &mut self,
+        t: f64,
+        t_sensor_target: &Pose,
+        v_sensor: Vector3<f64>,
+        w_target: Vector3<f64>,
+    ) -> Result<(), TrackError> {
+        self.filter
+            .initialize(t, t_sensor_target, v_sensor, w_target)?;
+        self.last = Some(LastPose {
+            t,
+            t_sensor_target: *t_sensor_target,
+        });
+        self.lost = false;
+        self.consecutive_degraded = 0;
+        Ok(())
+    }
+
+    /// Processes one frame: `points` in the sensor frame with per-point
+    /// timestamps in `[scan_start, scan_end]`.
+    ///
+    /// Per-frame failures (empty or all-NaN cloud, no correspondence,
+    /// degenerate geometry, inconsistency) are *reported* in the output's
+    /// status; `Err` is reserved for misuse (not initialised, scan times
+    /// not finite or not increasing).
+    pub fn process(
+        &mut self,
+        points: &[Point],
+        scan_start: f64,
+        scan_end: f64,
+    ) -> Result<TrackOutput, TrackError> {
+        let started = Instant::now();
+        let last = self.last.ok_or(TrackError::NotInitialized)?;
+        if !(scan_start.is_finite()
+            && scan_end.is_finite()
+            && scan_start <= scan_end
+            && scan_end > last.t)
+        {
+            return Err(TrackError::InvalidScanTimes {
+                start_s: scan_start,
+                end_s: scan_end,
+                previous_end_s: Some(last.t),
+            });
+        }
+        let prediction = self.filter.predict_at(scan_end)?;
+        if self.lost {
+            return Ok(self.lost_output(
+                &prediction,
+                points.len(),
+                "track lost: awaiting re-initialisation",
+                started,
+            ));
+        }
+        let pre = Instant::now();
+        let cloud = match self.preprocess(points, &prediction) {
+            Ok(c) => c,
+            Err(e) => {
+                return Ok(self.declare_lost(&prediction, points.len(), e.to_string(), started));
+            }
+        };
+        let preprocess_ms = ms(pre);
+        let reg_start = Instant::now();
+        let registration = match self.register(&cloud, &prediction, &last, scan_start, scan_end) {
+            Ok(r) => r,
+            Err(e) => {
+                return Ok(self.declare_lost(&prediction, points.len(), e.to_string(), started));
+            }
+        };
+        let registration_ms = ms(reg_start);
+        let mut out = self.assess(
+            registration,
+            &prediction,
+            scan_end,
+            points.len(),
+            cloud.len(),
+        )?;
+        out.timings = Timings {
+            preprocess_ms,
+            registration_ms,
+            total_ms: ms(started),
+        };
+        Ok(out)
+    }
+
+    /// Motion compensation (deblur mode) and the voxel filter.
+    fn preprocess(
+        &mut self,
+        points: &[Point],
+        prediction: &Prediction,
+    ) -> Result<Vec<Point>, TrackError> {
+        if self.config.mode == TrackingMode::Deblur {
+            let finite: Vec<Point> = points.iter().copied().filter(Point::is_finite).collect();
+            let compensated =
+                MotionCompensation::from_prediction(prediction)?.compensate(&finite)?;
+            return Ok(self.voxel.filter(&compensated)?.points);
+        }
+        Ok(self.voxel.filter(points)?.points)
+    }
+
+    /// Runs the registration of the current mode from its initial guess.
+    fn register(
+        &self,
+        cloud: &[Point],
+        prediction: &Prediction,
+        last: &LastPose,
+        scan_start: f64,
+        scan_end: f64,
+    ) -> Result<Registration, TrackError> {
+        let previous = last.t_sensor_target.inverse();
+        let predicted = prediction.pose.inverse();
+        let (map, icp, c) = (&self.model.map, &self.model.icp, &self.config);
+        Ok(match c.mode {
+            TrackingMode::Ndt => register_ndt(map, cloud, &previous, &c.ndt)?,
+            TrackingMode::Icp => register_icp(icp, cloud, &previous, &c.icp)?,
+            TrackingMode::Deblur => register_ndt(map, cloud, &predicted, &c.ndt)?,
+            TrackingMode::CtNdt => {
+                // T^s is the previous result (seed 000 §3.3) carried to the
+                // scan start by the filter when scans do not abut.
+                let start = if (scan_start - last.t).abs() < 1e-9 || scan_start < last.t {
+                    previous
+                } else {
+                    self.filter.predict_at(scan_start)?.pose.inverse()
+                };
+                let scan = ScanTimes {
+                    start_s: scan_start,
+                    end_s: scan_end,
+                };
+                register_ct_ndt(map, cloud, &scan, &start, &predicted, &c.ndt)?
+            }
+        })
+    }
+
+    /// Quality and consistency checks, filter update, status.
+    fn assess(
+        &mut self,
+        registration: Registration,
+        prediction: &Prediction,
+        t: f64,
+        points_in: usize,
+        points_used: usize,
+    ) -> Result<TrackOutput, TrackError> {
+        let measured = registration.t_sensor_target();
+        let innovation_rot_deg =
+            so3::distance(&measured.rotation, &prediction.pose.rotation).to_degrees();
+        let innovation_pos_m = (measured.translation - prediction.pose.translation).norm();
+        let covariance =
+            covariance_sensor_target(&registration.t_target_sensor, &registration.information);
+        let mut reasons = self.quality_issues(&registration);
+        let l = &self.config.loss;
+        if innovation_rot_deg > l.max_innovation_rot_deg
+            || innovation_pos_m > l.max_innovation_pos_m
+        {
+            reasons.push(format!(
+                "inconsistent with prediction ({innovation_rot_deg:.1} deg, {innovation_pos_m:.3} m)"
+            ));
+        }
+        if reasons.is_empty() {
+            let outcome = self.filter.update(t, &measured, covariance)?;
+            if !outcome.fused {
+                reasons.push(format!(
+                    "filter gate: Mahalanobis² {:.1}",
+                    outcome.mahalanobis2
+                ));
+            }
+        }
+        let status = if reasons.is_empty() {
+            self.consecutive_degraded = 0;
+            TrackStatus::Tracking
+        } else {
+            self.consecutive_degraded += 1;
+            if self.consecutive_degraded >= l.max_consecutive_degraded {
+                self.lost = true;
+                reasons.push(format!(
+                    "{} degraded frames in a row",
+                    self.consecutive_degraded
+                ));
+                TrackStatus::Lost
+            } else {
+                TrackStatus::Degraded
+            }
+        };
+        self.last = Some(LastPose {
+            t,
+            t_sensor_target: measured,
+        });
+        let estimate = self.filter.predict_at(t)?;
+        Ok(TrackOutput {
+            t,
+            t_sensor_target: measured,
+            covariance,
+            status,
+            reason: reasons.join("; "),
+            registration: Some(registration),
+            innovation_rot_deg,
+            innovation_pos_m,
+            w_target: estimate.w_target,
+            v_sensor: estimate.v_sensor,
+            points_in,
+            points_used,
+            timings: Timings::default(),
+        })
+    }
+
+    /// Reasons to doubt a registration on its own figures.
+    fn quality_issues(&self, r: &Registration) -> Vec<String> {
+        let l = &self.config.loss;
+        let mut reasons = Vec::new();
+        if r.inliers < l.min_inliers || r.inlier_fraction() < l.min_inlier_fraction {
+            reasons.push(format!(
+                "{} inliers ({:.0}%)",
+                r.inliers,
+                100.0 * r.inlier_fraction()
+            ));
+        }
+        let max_cost = if self.config.mode == TrackingMode::Icp {
+            l.max_mean_cost_icp_m2
+        } else {
+            l.max_mean_cost_ndt
+        };
+        if r.cost.mean.is_nan() || r.cost.mean > max_cost {
+            reasons.push(format!(
+                "mean cost {:.3e} above {max_cost:.3e}",
+                r.cost.mean
+            ));
+        }
+        let stalled = r.last_increment.rotation_rad.to_degrees()
+            > 10.0 * self.config.ndt.termination_rotation_deg
+            || r.last_increment.translation_m > 10.0 * self.config.ndt.termination_translation_m;
+        if !r.converged && stalled {
+            reasons.push(format!("no convergence after {} iterations", r.iterations));
+        }
+        reasons
+    }
+
+    fn declare_lost(
+        &mut self,
+        prediction: &Prediction,
+        points_in: usize,
+        reason: String,
+        started: Instant,
+    ) -> TrackOutput {
+        self.lost = true;
+        self.lost_output(prediction, points_in, &reason, started)
+    }
+
+    fn lost_output(
+        &self,
+        prediction: &Prediction,
+        points_in: usize,
+        reason: &str,
+        started: Instant,
+    ) -> TrackOutput {
+        TrackOutput {
+            t: prediction.t,
+            t_sensor_target: prediction.pose,
+            covariance: None,
+            status: TrackStatus::Lost,
+            reason: reason.to_string(),
+            registration: None,
+            innovation_rot_deg: f64::NAN,
+            innovation_pos_m: f64::NAN,
+            w_target: prediction.w_target,
+            v_sensor: prediction.v_sensor,
+            points_in,
+            points_used: 0,
+            timings: Timings {
+                total_ms: ms(started),
+                ..Timings::default()
+            },
+        }
+    }
+}
+
+fn ms(since: Instant) -> f64 {
+    since.elapsed().as_secs_f64() * 1e3
+}
