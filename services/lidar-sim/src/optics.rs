@@ -5,7 +5,7 @@
 use nalgebra::Vector3;
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
-use std::f64::consts::{FRAC_PI_2, TAU};
+use std::f64::consts::FRAC_PI_2;
 
 /// The bracket of seed 004 Eq. (17): `k_d cos θ + (1 - k_d) cos^η α`,
 /// the fraction of the incident intensity seen by an observer at angle `α`
@@ -14,7 +14,18 @@ use std::f64::consts::{FRAC_PI_2, TAU};
 /// contribution. Multiply by `I_I / r²` for the received intensity.
 #[inline]
 pub fn phong(kd: f64, eta: f64, cos_theta: f64, cos_alpha: f64) -> f64 {
-    kd * cos_theta.max(0.0) + (1.0 - kd) * cos_alpha.max(0.0).powf(eta)
+    let specular = if kd < 1.0 {
+        (1.0 - kd) * cos_pow(cos_alpha, eta)
+    } else {
+        0.0
+    };
+    kd * cos_theta.max(0.0) + specular
+}
+
+/// `max(c, 0)^η`, skipping the `powf` when the result is 0.
+#[inline]
+pub fn cos_pow(c: f64, eta: f64) -> f64 {
+    if c > 0.0 { c.powf(eta) } else { 0.0 }
 }
 
 /// Phong back-scatter toward a co-located emitter and receiver: Eq. (17)
@@ -66,6 +77,49 @@ pub fn tilt(axis: &Vector3<f64>, angle: f64, azimuth: f64) -> Vector3<f64> {
     axis * ca + (u * cp + v * sp) * sa
 }
 
+/// A uniformly distributed unit vector of the plane, `(cos φ, sin φ)`, by
+/// rejection from the unit square (cheaper than `sin_cos` of a uniform φ).
+#[inline]
+pub fn random_unit_circle(rng: &mut ChaCha8Rng) -> (f64, f64) {
+    loop {
+        let x: f64 = rng.random_range(-1.0..1.0);
+        let y: f64 = rng.random_range(-1.0..1.0);
+        let r2 = x * x + y * y;
+        if r2 > 1e-12 && r2 <= 1.0 {
+            let inv = 1.0 / r2.sqrt();
+            return (x * inv, y * inv);
+        }
+    }
+}
+
+/// A cone of directions about one axis, with its orthonormal basis
+/// precomputed (the divergent rays of one beam share it).
+#[derive(Debug, Clone, Copy)]
+pub struct Cone {
+    axis: Vector3<f64>,
+    u: Vector3<f64>,
+    v: Vector3<f64>,
+}
+
+impl Cone {
+    /// The cone about `axis` (unit).
+    #[inline]
+    pub fn new(axis: &Vector3<f64>) -> Self {
+        let (u, v) = orthonormal_basis(axis);
+        Cone { axis: *axis, u, v }
+    }
+
+    /// A direction at an angle uniform in `[0, max_angle]` from the axis, at
+    /// a uniform azimuth; returns the direction and the angle.
+    #[inline]
+    pub fn sample(&self, max_angle: f64, rng: &mut ChaCha8Rng) -> (Vector3<f64>, f64) {
+        let angle = rng.random_range(0.0..=max_angle);
+        let (c, s) = random_unit_circle(rng);
+        let (sa, ca) = angle.sin_cos();
+        (self.axis * ca + (self.u * c + self.v * s) * sa, angle)
+    }
+}
+
 /// A direction at an angle drawn uniformly in `[0, max_angle]` from `axis`,
 /// at a uniform azimuth; returns the direction and the drawn angle.
 /// Used for the divergent rays (γ ∈ [0, β], seed 004) and for the reflected
@@ -76,9 +130,7 @@ pub fn sample_cone(
     max_angle: f64,
     rng: &mut ChaCha8Rng,
 ) -> (Vector3<f64>, f64) {
-    let angle = rng.random_range(0.0..=max_angle);
-    let azimuth = rng.random_range(0.0..TAU);
-    (tilt(axis, angle, azimuth), angle)
+    Cone::new(axis).sample(max_angle, rng)
 }
 
 #[cfg(test)]
@@ -144,6 +196,20 @@ mod tests {
                 assert!((dir.angle(&axis) - angle).abs() < 1e-7);
                 assert!(angle <= 0.1);
             }
+        }
+        // Uniform azimuth: the mean of (cos φ, sin φ) and of (cos 2φ, sin 2φ) vanish.
+        let n = 20_000;
+        let (mut c1, mut s1, mut c2, mut s2) = (0.0, 0.0, 0.0, 0.0);
+        for _ in 0..n {
+            let (c, s) = random_unit_circle(&mut rng);
+            assert!((c * c + s * s - 1.0).abs() < 1e-12);
+            c1 += c;
+            s1 += s;
+            c2 += c * c - s * s;
+            s2 += 2.0 * c * s;
+        }
+        for m in [c1, s1, c2, s2] {
+            assert!((m / n as f64).abs() < 0.02, "{m}");
         }
     }
 }
