@@ -115,8 +115,10 @@ impl Default for SensorConfig {
 impl SensorConfig {
     /// Default integration time of the Mid-40 model (s), chosen so that a
     /// `deos` target at 10 m on the boresight returns about 10,000 points
-    /// with every effect on (seed 004 §IV.C: adaptive integration time for
-    /// ~10,000 target points).
+    /// with the default effects (seed 004 §IV.C: adaptive integration time
+    /// for ~10,000 target points). Measured over 16 random attitudes: mean
+    /// 10,215 points (1,467 when a specular MLI end face is seen obliquely,
+    /// up to 15,361); 15,235 on average with no effect at all (72,000 rays).
     pub const MID40_INTEGRATION_TIME_S: f64 = 0.72;
 
     /// Livox Mid-40: rosette over a 38.4° circle at 100,000 points/s,
