@@ -187,6 +187,36 @@ impl RelativeMotionFilter {
         Ok(())
     }
 
+    /// Replaces the whole state with `state` (e.g. the `FilterState` the
+    /// filter service published): the estimate and both covariances at time
+    /// `state.t`. Used by a tracker that keeps a local copy of the
+    /// authoritative filter. Fails on non-finite values or covariances that
+    /// are not symmetric positive semi-definite.
+    pub fn restore(&mut self, state: &Prediction) -> Result<(), FilterError> {
+        if !state.t.is_finite() {
+            return Err(FilterError::NonFinite {
+                what: "restored time",
+            });
+        }
+        let position = PositionFilter::new(
+            state.pose.translation,
+            state.v_sensor,
+            state.position_covariance,
+        )?;
+        let attitude = AttitudeFilter::new(
+            state.pose.rotation,
+            state.w_target,
+            state.attitude_covariance,
+        )?;
+        self.state = Some(State {
+            t: state.t,
+            position,
+            attitude,
+        });
+        self.consecutive_rejections = 0;
+        Ok(())
+    }
+
     /// The estimate at the time of the last update (or initialisation).
     pub fn estimate(&self) -> Result<Prediction, FilterError> {
         let s = self.state.ok_or(FilterError::NotInitialized)?;

@@ -253,3 +253,36 @@ fn bad_input_is_an_error() {
     assert_eq!(f.time(), Some(1.0));
     assert!(f.update(2.0, &truth.pose(2.0), None).unwrap().fused);
 }
+
+#[test]
+fn restore_reproduces_the_published_estimate() {
+    use nalgebra::Vector3;
+    let mut source = RelativeMotionFilter::new(FilterConfig::default()).unwrap();
+    let pose = Pose::new(
+        spacepose_geometry::so3::exp(&Vector3::new(0.1, 0.2, -0.3)),
+        Vector3::new(0.5, -0.2, 10.0),
+    );
+    source
+        .initialize(
+            1.0,
+            &pose,
+            Vector3::new(0.0, 0.0, -0.02),
+            Vector3::new(0.0, 0.17, 0.0),
+        )
+        .unwrap();
+    let moved = Pose::new(
+        pose.rotation * spacepose_geometry::so3::exp(&Vector3::new(0.0, 0.17, 0.0)),
+        Vector3::new(0.5, -0.2, 9.98),
+    );
+    source.update(2.0, &moved, None).unwrap();
+    let published = source.estimate().unwrap();
+    let mut copy = RelativeMotionFilter::new(FilterConfig::default()).unwrap();
+    copy.restore(&published).unwrap();
+    let a = source.predict_at(3.5).unwrap();
+    let b = copy.predict_at(3.5).unwrap();
+    assert!(a.pose.error_to(&b.pose).0 < 1e-12 && a.pose.error_to(&b.pose).1 < 1e-12);
+    assert!((a.covariance - b.covariance).norm() < 1e-12);
+    let mut bad = published;
+    bad.t = f64::NAN;
+    assert!(copy.restore(&bad).is_err());
+}

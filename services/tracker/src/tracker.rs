@@ -76,6 +76,17 @@ impl Tracker {
         Ok(self.filter.predict_at(t)?)
     }
 
+    /// Replaces the local filter with the authoritative state published by
+    /// the filter service (suite deployments). Ignored while the track is
+    /// not initialised or when the state is older than the local one.
+    pub fn restore_filter(&mut self, state: &Prediction) -> Result<(), TrackError> {
+        if self.last.is_none() || self.filter.time().is_some_and(|t| state.t < t) {
+            return Ok(());
+        }
+        self.filter.restore(state)?;
+        Ok(())
+    }
+
     /// (Re)starts tracking from `t_sensor_target` at time `t` (truth before
     /// acquisition exists, an acquisition result afterwards). Unknown rates
     /// are passed as zeros: the filter starts at ω = 0 (seed 000 §5.2).
