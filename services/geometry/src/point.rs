@@ -10,7 +10,9 @@ use serde::{Deserialize, Serialize};
 /// of the cloud that holds the point (the sensor frame for raw frames);
 /// `t` is the acquisition time in seconds on the sensor clock.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize, bytemuck::Pod, bytemuck::Zeroable,
+)]
 pub struct Point {
     /// x coordinate (m).
     pub x: f32,

@@ -1,0 +1,1 @@
+//! iceoryx2 and zenoh transport of the spacepose service suite.

@@ -1,0 +1,119 @@
+//! Health and heartbeat of every service.
+
+use crate::codec::{CodecError, WireMessage, check_code, check_name, fixed_max_wire_bytes};
+use crate::error::MessageError;
+use crate::{Name, SCHEMA_VERSION};
+use iceoryx2::prelude::ZeroCopySend;
+use serde::{Deserialize, Serialize};
+
+/// Life-cycle state of a service (stored as `u8` in [`Health::state`]).
+#[repr(u8)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum ServiceState {
+    /// Started, not yet processing.
+    Starting = 0,
+    /// Processing normally.
+    Running = 1,
+    /// Processing, but with errors or a lost track.
+    Degraded = 2,
+    /// Shutting down.
+    Stopping = 3,
+}
+
+impl ServiceState {
+    /// Decodes the `u8` code.
+    pub fn from_u8(code: u8) -> Result<ServiceState, MessageError> {
+        match code {
+            0 => Ok(ServiceState::Starting),
+            1 => Ok(ServiceState::Running),
+            2 => Ok(ServiceState::Degraded),
+            3 => Ok(ServiceState::Stopping),
+            _ => Err(MessageError::UnknownCode {
+                what: "service state",
+                code,
+            }),
+        }
+    }
+
+    /// Lower-case name (`"starting"`, `"running"`, `"degraded"`, `"stopping"`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ServiceState::Starting => "starting",
+            ServiceState::Running => "running",
+            ServiceState::Degraded => "degraded",
+            ServiceState::Stopping => "stopping",
+        }
+    }
+}
+
+/// Heartbeat and counters of one service instance.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
+#[type_name("spacepose::Health")]
+pub struct Health {
+    /// Schema version of the sender ([`SCHEMA_VERSION`]).
+    pub schema: u16,
+    /// [`ServiceState`] code.
+    pub state: u8,
+    /// Process id of the service.
+    pub pid: u32,
+    /// Instance name (e.g. `"tracker-a"`).
+    pub instance: Name,
+    /// Service kind (e.g. `"tracker"`).
+    pub service: Name,
+    /// Heartbeat counter (starts at 0).
+    pub sequence: u64,
+    /// Sequence of the last frame processed.
+    pub last_frame: u64,
+    /// Time since the service started (s).
+    pub uptime_s: f64,
+    /// Frames (or messages) received.
+    pub frames_in: u64,
+    /// Frames (or messages) published.
+    pub frames_out: u64,
+    /// Frames rejected because they held NaN/infinite points.
+    pub rejected_non_finite: u64,
+    /// Frames rejected because they were empty.
+    pub rejected_empty: u64,
+    /// Frames rejected because they exceeded the cloud capacity.
+    pub rejected_oversized: u64,
+    /// Wire payloads rejected by the codec (garbage on a zenoh key).
+    pub rejected_wire: u64,
+    /// Other errors (registration failures, bus errors).
+    pub errors: u64,
+    /// CLOCK_REALTIME at send (ns since the Unix epoch).
+    pub published_ns: i64,
+}
+
+impl Health {
+    /// A fresh heartbeat for `service`/`instance` of process `pid`, state starting.
+    pub fn new(service: Name, instance: Name, pid: u32) -> Self {
+        Self {
+            schema: SCHEMA_VERSION,
+            state: ServiceState::Starting as u8,
+            pid,
+            instance,
+            service,
+            ..Self::default()
+        }
+    }
+}
+
+impl WireMessage for Health {
+    const KIND: u8 = 6;
+    const MAX_WIRE_BYTES: usize = fixed_max_wire_bytes::<Self>();
+
+    fn schema(&self) -> u16 {
+        self.schema
+    }
+
+    fn validate(&self) -> Result<(), CodecError> {
+        check_code("state", self.state, ServiceState::Stopping as u8)?;
+        check_name("instance", &self.instance)?;
+        check_name("service", &self.service)
+    }
+
+    fn set_published_ns(&mut self, ns: i64) {
+        self.published_ns = ns;
+    }
+}
