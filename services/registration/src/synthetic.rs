@@ -123,13 +123,17 @@ impl SyntheticTarget {
             false,
         ));
         let mut surface = Vec::new();
+        let mut state = 0x5eed_u64;
         for f in &faces {
             let na = (f.a.norm() / spacing_m).ceil().max(1.0) as usize;
             let nb = (f.b.norm() / spacing_m).ceil().max(1.0) as usize;
             for i in 0..na {
                 for j in 0..nb {
-                    let s = (i as f64 + 0.5) / na as f64;
-                    let t = (j as f64 + 0.5) / nb as f64;
+                    // Jittered grid: one uniform sample per grid cell, so the
+                    // model and the voxel-filtered frames never share a lattice
+                    // (a regular lattice biases point-to-point ICP by aliasing).
+                    let s = (i as f64 + jitter(&mut state)) / na as f64;
+                    let t = (j as f64 + jitter(&mut state)) / nb as f64;
                     surface.push(SurfacePoint {
                         position: f.origin + f.a * s + f.b * t,
                         normal: f.normal,
@@ -220,6 +224,17 @@ impl SyntheticTarget {
             })
             .collect()
     }
+}
+
+/// A deterministic uniform number in `[0, 1)` (SplitMix64), so the
+/// fixture needs no RNG dependency and is identical on every machine.
+fn jitter(state: &mut u64) -> f64 {
+    *state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 53) as f64
 }
 
 /// Mean of the points falling in each cubic voxel of edge `voxel_m`, in
