@@ -1,0 +1,187 @@
+//! The ingest stage: validate, crop to the region of interest, voxel-filter
+//! keeping timestamps (seed 000 §3.3).
+
+use crate::config::IngestConfig;
+use crate::error::IngestError;
+use crate::roi::{Roi, RoiKind, TargetPrediction};
+use crate::stats::IngestStats;
+use spacepose_geometry::{Point, VoxelFilter};
+
+/// What happened to one accepted frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameReport {
+    /// Points received.
+    pub input_points: usize,
+    /// Non-finite points dropped.
+    pub non_finite_points: usize,
+    /// Finite points outside the region of interest.
+    pub cropped_points: usize,
+    /// Points inside the region of interest (before voxel filtering).
+    pub roi_points: usize,
+    /// Points out (after voxel filtering).
+    pub output_points: usize,
+    /// The region used.
+    pub roi: RoiKind,
+}
+
+/// Crop + voxel filter, with reusable buffers and running statistics.
+#[derive(Debug, Clone)]
+pub struct IngestStage {
+    config: IngestConfig,
+    voxel: Option<VoxelFilter>,
+    roi_points: Vec<Point>,
+    stats: IngestStats,
+}
+
+impl IngestStage {
+    /// A stage after validating `config`.
+    pub fn new(config: IngestConfig) -> Result<Self, IngestError> {
+        config.validate()?;
+        let voxel = if config.leaf_size_m > 0.0 {
+            Some(VoxelFilter::new(config.leaf_size_m)?)
+        } else {
+            None
+        };
+        Ok(IngestStage {
+            config,
+            voxel,
+            roi_points: Vec::new(),
+            stats: IngestStats::default(),
+        })
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &IngestConfig {
+        &self.config
+    }
+
+    /// Counters since creation.
+    pub fn stats(&self) -> &IngestStats {
+        &self.stats
+    }
+
+    /// Processes one frame scanned over `[scan_start_s, scan_end_s]` into a new vector.
+    pub fn process(
+        &mut self,
+        points: &[Point],
+        scan_start_s: f64,
+        scan_end_s: f64,
+        prediction: Option<&TargetPrediction>,
+    ) -> Result<(Vec<Point>, FrameReport), IngestError> {
+        let mut out = Vec::new();
+        let report = self.process_into(points, scan_start_s, scan_end_s, prediction, &mut out)?;
+        Ok((out, report))
+    }
+
+    /// Processes one frame into `out` (cleared first; left empty on error).
+    ///
+    /// # Errors
+    /// [`IngestError::EmptyFrame`], [`IngestError::Oversized`],
+    /// [`IngestError::AllNonFinite`], [`IngestError::BadScanInterval`] or
+    /// [`IngestError::Voxel`]; each is counted in [`IngestStats`].
+    pub fn process_into(
+        &mut self,
+        points: &[Point],
+        scan_start_s: f64,
+        scan_end_s: f64,
+        prediction: Option<&TargetPrediction>,
+        out: &mut Vec<Point>,
+    ) -> Result<FrameReport, IngestError> {
+        out.clear();
+        self.stats.frames_in += 1;
+        let result = self.run(points, scan_start_s, scan_end_s, prediction, out);
+        if let Err(e) = &result {
+            out.clear();
+            let s = &mut self.stats;
+            match e {
+                IngestError::EmptyFrame => s.rejected_empty += 1,
+                IngestError::Oversized { .. } => s.rejected_oversized += 1,
+                IngestError::AllNonFinite { .. } => {
+                    s.rejected_all_non_finite += 1;
+                    s.frames_with_non_finite += 1;
+                }
+                _ => s.rejected_other += 1,
+            }
+        }
+        result
+    }
+
+    fn run(
+        &mut self,
+        points: &[Point],
+        scan_start_s: f64,
+        scan_end_s: f64,
+        prediction: Option<&TargetPrediction>,
+        out: &mut Vec<Point>,
+    ) -> Result<FrameReport, IngestError> {
+        let n = points.len();
+        if n == 0 {
+            return Err(IngestError::EmptyFrame);
+        }
+        if n > self.config.max_points {
+            return Err(IngestError::Oversized {
+                points: n,
+                capacity: self.config.max_points,
+            });
+        }
+        if !(scan_start_s.is_finite() && scan_end_s.is_finite() && scan_start_s <= scan_end_s) {
+            return Err(IngestError::BadScanInterval {
+                scan_start_s,
+                scan_end_s,
+            });
+        }
+        let (roi, issue) = Roi::for_frame(&self.config, prediction, scan_start_s, scan_end_s);
+        let crop = crop_into(&roi, points, &mut self.roi_points);
+        if crop.non_finite == n {
+            return Err(IngestError::AllNonFinite { points: n });
+        }
+        match &mut self.voxel {
+            Some(voxel) => {
+                voxel.filter_into(&self.roi_points, out)?;
+            }
+            None => out.extend_from_slice(&self.roi_points),
+        }
+        let s = &mut self.stats;
+        s.frames_out += 1;
+        s.frames_with_non_finite += u64::from(crop.non_finite > 0);
+        s.non_finite_points += crop.non_finite as u64;
+        s.cropped_points += crop.outside as u64;
+        s.ignored_predictions += u64::from(issue.is_some());
+        s.frames_without_prediction += u64::from(roi.centre().is_none());
+        s.frames_empty_after_crop += u64::from(self.roi_points.is_empty());
+        Ok(FrameReport {
+            input_points: n,
+            non_finite_points: crop.non_finite,
+            cropped_points: crop.outside,
+            roi_points: self.roi_points.len(),
+            output_points: out.len(),
+            roi: roi.kind(),
+        })
+    }
+}
+
+/// Counts of one crop.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct CropCounts {
+    /// Points with a NaN or infinite field.
+    pub non_finite: usize,
+    /// Finite points outside the region.
+    pub outside: usize,
+}
+
+/// Copies the finite points of `points` inside `roi` into `out` (cleared
+/// first), in input (time) order.
+pub fn crop_into(roi: &Roi, points: &[Point], out: &mut Vec<Point>) -> CropCounts {
+    out.clear();
+    let mut counts = CropCounts::default();
+    for p in points {
+        if !p.is_finite() {
+            counts.non_finite += 1;
+        } else if roi.contains(p) {
+            out.push(*p);
+        } else {
+            counts.outside += 1;
+        }
+    }
+    counts
+}

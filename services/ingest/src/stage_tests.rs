@@ -1,0 +1,154 @@
+//! Bad input and the voxel step of [`IngestStage`].
+
+use crate::{IngestConfig, IngestError, IngestStage, RoiKind, TargetPrediction};
+use nalgebra::Vector3;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use spacepose_geometry::Point;
+
+/// Points uniformly in a 1 m cube about (0, 0, 10), timestamps over [0, 1].
+fn cube(n: usize, seed: u64) -> Vec<Point> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..n)
+        .map(|i| {
+            Point::new(
+                rng.random_range(-0.5..0.5),
+                rng.random_range(-0.5..0.5),
+                rng.random_range(9.5..10.5),
+                1.0,
+                i as f64 / n as f64,
+            )
+        })
+        .collect()
+}
+
+fn stage() -> IngestStage {
+    IngestStage::new(IngestConfig {
+        max_points: 10_000,
+        ..IngestConfig::default()
+    })
+    .unwrap()
+}
+
+#[test]
+fn bad_frames_are_rejected_counted_and_the_next_frame_still_passes() {
+    let mut s = stage();
+    let good = cube(2000, 1);
+    assert!(matches!(
+        s.process(&[], 0.0, 1.0, None),
+        Err(IngestError::EmptyFrame)
+    ));
+    assert!(matches!(
+        s.process(&cube(10_001, 2), 0.0, 1.0, None),
+        Err(IngestError::Oversized {
+            points: 10_001,
+            capacity: 10_000
+        })
+    ));
+    let nan = vec![Point::new(f32::NAN, 0.0, 1.0, 1.0, 0.0); 50];
+    assert!(matches!(
+        s.process(&nan, 0.0, 1.0, None),
+        Err(IngestError::AllNonFinite { points: 50 })
+    ));
+    assert!(matches!(
+        s.process(&good, f64::NAN, 1.0, None),
+        Err(IngestError::BadScanInterval { .. })
+    ));
+    assert!(matches!(
+        s.process(&good, 2.0, 1.0, None),
+        Err(IngestError::BadScanInterval { .. })
+    ));
+    // Some NaN / infinite points: dropped and counted, the rest goes through.
+    let mut mixed = good.clone();
+    mixed[3].y = f32::NAN;
+    mixed[7].t = f64::INFINITY;
+    mixed[9].intensity = f32::NEG_INFINITY;
+    let (out, report) = s.process(&mixed, 0.0, 1.0, None).unwrap();
+    assert_eq!(report.non_finite_points, 3);
+    assert_eq!(report.roi_points, 1997);
+    assert!(!out.is_empty() && out.iter().all(Point::is_finite));
+    let (_, report) = s.process(&good, 0.0, 1.0, None).unwrap();
+    assert_eq!(report.non_finite_points, 0);
+    let st = *s.stats();
+    assert_eq!(st.frames_in, 7);
+    assert_eq!(st.frames_out, 2);
+    assert_eq!(st.rejected_empty, 1);
+    assert_eq!(st.rejected_oversized, 1);
+    assert_eq!(st.rejected_all_non_finite, 1);
+    assert_eq!(st.rejected_other, 2);
+    assert_eq!(st.frames_with_non_finite, 2);
+    assert_eq!(st.non_finite_points, 3);
+}
+
+#[test]
+fn voxel_filter_reduces_the_cloud_and_keeps_mean_timestamps() {
+    // Two points per 2 cm voxel: pairs 1 mm apart at times 2k and 2k+1 ms.
+    let mut pts = Vec::new();
+    for k in 0..500 {
+        let x = 0.02 * k as f32 + 0.005;
+        pts.push(Point::new(x, 0.005, 10.005, 1.0, 0.002 * k as f64));
+        pts.push(Point::new(
+            x + 0.001,
+            0.005,
+            10.005,
+            3.0,
+            0.002 * k as f64 + 0.001,
+        ));
+    }
+    let mut s = stage();
+    let (out, report) = s.process(&pts, 0.0, 1.0, None).unwrap();
+    assert_eq!(report.roi_points, 1000);
+    assert_eq!(out.len(), 500);
+    for (k, p) in out.iter().enumerate() {
+        assert!((p.t - (0.002 * k as f64 + 0.0005)).abs() < 1e-9);
+        assert!((p.intensity - 2.0).abs() < 1e-6);
+    }
+    // leaf_size_m = 0 disables the voxel step.
+    let mut raw = IngestStage::new(IngestConfig {
+        leaf_size_m: 0.0,
+        ..IngestConfig::default()
+    })
+    .unwrap();
+    let (out, _) = raw.process(&pts, 0.0, 1.0, None).unwrap();
+    assert_eq!(out, pts);
+}
+
+#[test]
+fn a_prediction_crops_to_the_sphere_and_a_wrong_one_empties_the_frame() {
+    let mut s = stage();
+    let mut pts = cube(1000, 3);
+    // A far point (wall) and a near one (window).
+    pts.push(Point::new(0.0, 0.0, 16.0, 1.0, 0.5));
+    pts.push(Point::new(0.0, 0.0, 0.3, 1.0, 0.5));
+    let pred = TargetPrediction {
+        t_s: 0.0,
+        p_sensor_target: Vector3::new(0.0, 0.0, 10.0),
+        v_sensor: Vector3::zeros(),
+        attitude: None,
+    };
+    let (_, r) = s.process(&pts, 0.0, 1.0, Some(&pred)).unwrap();
+    assert_eq!(r.roi, RoiKind::Predicted);
+    assert_eq!((r.roi_points, r.cropped_points), (1000, 2));
+    let (_, r) = s.process(&pts, 0.0, 1.0, None).unwrap();
+    assert_eq!(r.roi, RoiKind::RangeOnly);
+    assert_eq!((r.roi_points, r.cropped_points), (1001, 1));
+    let far = TargetPrediction {
+        p_sensor_target: Vector3::new(0.0, 0.0, 30.0),
+        ..pred
+    };
+    let (out, r) = s.process(&pts, 0.0, 1.0, Some(&far)).unwrap();
+    assert!(out.is_empty() && r.roi_points == 0);
+    assert_eq!(s.stats().frames_empty_after_crop, 1);
+    assert_eq!(s.stats().frames_without_prediction, 1);
+}
+
+#[test]
+fn an_invalid_config_is_refused() {
+    assert!(
+        IngestStage::new(IngestConfig {
+            max_range_m: f64::NAN,
+            ..IngestConfig::default()
+        })
+        .is_err()
+    );
+}

@@ -1,0 +1,31 @@
+//! Counters of the ingest stage since it was created.
+
+/// What the ingest stage has seen and rejected. Frame counters count frames;
+/// `*_points` counters count points.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct IngestStats {
+    /// Frames offered to [`crate::IngestStage::process`].
+    pub frames_in: u64,
+    /// Frames that came out cropped and filtered.
+    pub frames_out: u64,
+    /// Frames rejected because they held no point.
+    pub rejected_empty: u64,
+    /// Frames rejected because they exceeded `max_points`.
+    pub rejected_oversized: u64,
+    /// Frames rejected because every point was non-finite.
+    pub rejected_all_non_finite: u64,
+    /// Frames rejected for another reason (bad scan interval, voxel error).
+    pub rejected_other: u64,
+    /// Frames that had at least one non-finite point (all-NaN frames included).
+    pub frames_with_non_finite: u64,
+    /// Non-finite points dropped from accepted frames.
+    pub non_finite_points: u64,
+    /// Finite points outside the region of interest.
+    pub cropped_points: u64,
+    /// Accepted frames cropped without a trusted prediction.
+    pub frames_without_prediction: u64,
+    /// Predictions ignored because stale or non-finite.
+    pub ignored_predictions: u64,
+    /// Accepted frames with no point left in the region of interest.
+    pub frames_empty_after_crop: u64,
+}
