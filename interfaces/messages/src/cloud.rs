@@ -77,6 +77,18 @@ pub fn as_wire(points: &[Point]) -> &[WirePoint] {
     bytemuck::cast_slice(points)
 }
 
+impl From<Point> for WirePoint {
+    fn from(p: Point) -> Self {
+        bytemuck::cast(p)
+    }
+}
+
+impl From<WirePoint> for Point {
+    fn from(w: WirePoint) -> Self {
+        bytemuck::cast(w)
+    }
+}
+
 /// A whole frame as one value, for zenoh (postcard) and tests.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CloudMsg {

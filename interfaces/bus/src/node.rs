@@ -1,0 +1,186 @@
+//! The per-process iceoryx2 node: configuration, dead-node cleanup and the
+//! service builders shared by publishers and subscribers.
+
+use crate::error::BusError;
+use crate::limits::*;
+use crate::waiter::Waiter;
+use iceoryx2::node::{NodeView, NodeWaitFailure};
+use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::{event, publish_subscribe};
+use spacepose_messages::{CloudHeader, Name, Names, WirePoint};
+use std::fmt::Debug;
+use std::time::Duration;
+
+/// Event (wake-up) service of a topic.
+pub(crate) type EventFactory = event::PortFactory<ipc::Service>;
+
+/// One iceoryx2 node per process, isolated by the deployment prefix.
+pub struct Bus {
+    node: Node<ipc::Service>,
+    names: Names,
+    cleaned_dead_nodes: usize,
+}
+
+impl std::fmt::Debug for Bus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Bus")
+            .field("prefix", &self.names.prefix())
+            .field("node", &self.node.name())
+            .finish()
+    }
+}
+
+/// The iceoryx2 configuration of a deployment: defaults (no config file is
+/// read) with `global.prefix` = [`Names::iceoryx2_prefix`], so two suites on
+/// one machine never share a shared-memory file.
+pub fn iceoryx2_config(names: &Names) -> Result<Config, BusError> {
+    let mut config = Config::default();
+    let prefix = names.iceoryx2_prefix();
+    config.global.prefix = FileName::new(prefix.as_bytes()).map_err(|e| BusError::InvalidName {
+        name: prefix.clone(),
+        reason: format!("{e:?}"),
+    })?;
+    Ok(config)
+}
+
+/// Removes the stale resources of every dead node of this deployment
+/// (a process that died without cleaning up). Returns how many were removed.
+pub fn cleanup_dead_nodes(config: &Config) -> Result<usize, BusError> {
+    let mut dead = Vec::new();
+    Node::<ipc::Service>::list(config, |state| {
+        if let NodeState::Dead(view) = state {
+            dead.push(view);
+        }
+        CallbackProgression::Continue
+    })
+    .map_err(|e| BusError::Node(format!("listing nodes: {e:?}")))?;
+    let mut cleaned = 0;
+    for view in dead {
+        let id = format!("{:?}", view.id());
+        match view.try_remove_stale_resources() {
+            Ok(()) => {
+                tracing::info!(node = %id, "removed stale resources of a dead iceoryx2 node");
+                cleaned += 1;
+            }
+            Err(e) => tracing::warn!(node = %id, error = ?e, "could not clean up a dead node"),
+        }
+    }
+    Ok(cleaned)
+}
+
+fn service_name(service: &str) -> Result<ServiceName, BusError> {
+    ServiceName::new(service).map_err(|e| BusError::InvalidName {
+        name: service.to_string(),
+        reason: format!("{e:?}"),
+    })
+}
+
+impl Bus {
+    /// Opens this process's node `node_name` (an instance name: 1 to 24
+    /// characters of `[A-Za-z0-9_.-]`) in the deployment of `names`, after
+    /// removing the resources of dead nodes of the same deployment.
+    pub fn open(names: &Names, node_name: &str) -> Result<Bus, BusError> {
+        Name::new(node_name).map_err(|e| BusError::InvalidName {
+            name: node_name.to_string(),
+            reason: e.to_string(),
+        })?;
+        let config = iceoryx2_config(names)?;
+        let cleaned_dead_nodes = cleanup_dead_nodes(&config)?;
+        let name = NodeName::new(node_name).map_err(|e| BusError::InvalidName {
+            name: node_name.to_string(),
+            reason: format!("{e:?}"),
+        })?;
+        let node = NodeBuilder::new()
+            .name(&name)
+            .config(&config)
+            .create::<ipc::Service>()
+            .map_err(|e| BusError::Node(format!("creating node {node_name:?}: {e:?}")))?;
+        Ok(Bus {
+            node,
+            names: names.clone(),
+            cleaned_dead_nodes,
+        })
+    }
+
+    /// The deployment names.
+    pub fn names(&self) -> &Names {
+        &self.names
+    }
+
+    /// How many dead nodes [`Bus::open`] cleaned up.
+    pub fn cleaned_dead_nodes(&self) -> usize {
+        self.cleaned_dead_nodes
+    }
+
+    /// A waiter with termination handling: once it has waited, SIGINT and
+    /// SIGTERM are caught by iceoryx2 and reported as
+    /// [`crate::WakeReason::TerminationRequested`].
+    pub fn waitset(&self) -> Result<Waiter, BusError> {
+        Waiter::new(SignalHandlingMode::HandleTerminationRequests)
+    }
+
+    /// A waiter that leaves signals alone (for helper threads, so they do not
+    /// consume the main loop's termination request).
+    pub fn waitset_without_signals(&self) -> Result<Waiter, BusError> {
+        Waiter::new(SignalHandlingMode::Disabled)
+    }
+
+    /// Sleeps `cycle` for loops that are driven by time rather than by
+    /// messages (e.g. a sensor at 10 Hz). Returns `false` when SIGINT/SIGTERM
+    /// arrived (after the first call they are caught, so the loop must stop).
+    pub fn sleep(&self, cycle: Duration) -> Result<bool, BusError> {
+        match self.node.wait(cycle) {
+            Ok(()) => Ok(true),
+            Err(NodeWaitFailure::TerminationRequest | NodeWaitFailure::Interrupt) => Ok(false),
+        }
+    }
+
+    /// The publish-subscribe service of a fixed-size message.
+    pub(crate) fn message_service<T: Debug + ZeroCopySend + 'static>(
+        &self,
+        service: &str,
+    ) -> Result<publish_subscribe::PortFactory<ipc::Service, T, ()>, BusError> {
+        self.node
+            .service_builder(&service_name(service)?)
+            .publish_subscribe::<T>()
+            .max_publishers(MAX_PUBLISHERS)
+            .max_subscribers(MAX_SUBSCRIBERS)
+            .max_nodes(MAX_NODES)
+            .subscriber_max_buffer_size(MESSAGE_BUFFER)
+            .history_size(0)
+            .open_or_create()
+            .map_err(|e| BusError::service(service, e))
+    }
+
+    /// The publish-subscribe service of a cloud (`[WirePoint]` + `CloudHeader`).
+    pub(crate) fn cloud_service(
+        &self,
+        service: &str,
+    ) -> Result<publish_subscribe::PortFactory<ipc::Service, [WirePoint], CloudHeader>, BusError>
+    {
+        self.node
+            .service_builder(&service_name(service)?)
+            .publish_subscribe::<[WirePoint]>()
+            .user_header::<CloudHeader>()
+            .max_publishers(CLOUD_MAX_PUBLISHERS)
+            .max_subscribers(CLOUD_MAX_SUBSCRIBERS)
+            .max_nodes(MAX_NODES)
+            .subscriber_max_buffer_size(CLOUD_BUFFER)
+            .subscriber_max_borrowed_samples(CLOUD_BORROWED)
+            .history_size(0)
+            .open_or_create()
+            .map_err(|e| BusError::service(service, e))
+    }
+
+    /// The event service that wakes the subscribers of `service`.
+    pub(crate) fn event_service(&self, service: &str) -> Result<EventFactory, BusError> {
+        self.node
+            .service_builder(&service_name(service)?)
+            .event()
+            .max_notifiers(MAX_NOTIFIERS)
+            .max_listeners(MAX_LISTENERS)
+            .max_nodes(EVENT_MAX_NODES)
+            .open_or_create()
+            .map_err(|e| BusError::service(service, e))
+    }
+}
