@@ -134,17 +134,18 @@ pub fn ct_point_jacobian(start: &Pose, end: &Pose, u: f64, z: &Vector3<f64>) -> 
     j
 }
 
-/// Normal equations of Eq. (14) at end pose `end`.
+/// Normal equations of Eq. (14) at end pose `end`, every `stride`-th point.
 fn linearise(
     map: &NdtMap,
     points: &[(Vector3<f64>, f64)],
     start: &Pose,
     end: &Pose,
+    stride: usize,
     params: &NdtParams,
 ) -> NormalEquations {
     let interp = Interpolation::new(start, end);
     let mut ne = NormalEquations::new();
-    for (z, u) in points {
+    for (z, u) in points.iter().step_by(stride.max(1)) {
         let (rz, x, d_exp_u) = interp.apply(z, *u);
         if let Some((k, _)) = map.nearest_cell(&x, params.max_distance_m, params.lookup) {
             let (mean, information) = map.mean_and_information(k);
@@ -202,7 +203,7 @@ pub fn register_ct_ndt(
         params,
         points.len(),
         skipped,
-        |end| linearise(map, &points, t_target_sensor_start, end, params),
+        |end, stride| linearise(map, &points, t_target_sensor_start, end, stride, params),
     )
 }
 

@@ -1,6 +1,6 @@
 //! The Gauss-Newton loop on SE(3) shared by NDT and CT-NDT (seed 000 §3.1):
 //! linearise, solve Eq. (7), update `T ← ε ⊕ T` (Eq. 5), stop on a small
-//! increment (Table 1), then evaluate once more at the returned pose.
+//! increment (Table 1).
 
 use crate::error::RegistrationError;
 use crate::normal_equations::{NormalEquations, increment_of};
@@ -8,30 +8,48 @@ use crate::params::NdtParams;
 use crate::result::{Cost, Increment, Registration};
 use spacepose_geometry::Pose;
 
-/// Runs Gauss-Newton from `initial`. `linearise(T)` returns the normal
-/// equations at `T`; the function never allocates per iteration itself.
+/// Runs Gauss-Newton from `initial`. `linearise(T, stride)` returns the
+/// normal equations at `T` over every `stride`-th point; nothing is
+/// allocated per iteration.
 ///
-/// The returned cost, inliers and information are those of a final
-/// evaluation at the returned pose (one extra association pass), so they
-/// describe the estimate itself rather than the previous iterate.
+/// Coarse phase (speed, not in the paper): while `params.coarse_stride > 1`
+/// the increments are computed on every `coarse_stride`-th point only,
+/// until an increment falls below `coarse_switch` times the termination
+/// thresholds; all later iterations, and the convergence test, use every
+/// point, so the optimum reached is that of the full cloud.
+///
+/// Cost, inliers and information: when converged, those of the last
+/// (full) linearisation, i.e. at the pose before the last increment, which
+/// is below the termination thresholds (0.05°, 1 mm by default); otherwise
+/// a final evaluation at the returned pose.
 pub(crate) fn run(
     initial: Pose,
     params: &NdtParams,
     valid_points: usize,
     skipped_non_finite: usize,
-    mut linearise: impl FnMut(&Pose) -> NormalEquations,
+    mut linearise: impl FnMut(&Pose, usize) -> NormalEquations,
 ) -> Result<Registration, RegistrationError> {
     let no_match = |iteration| RegistrationError::NoCorrespondences {
         iteration,
         max_distance_m: params.max_distance_m,
     };
     let rot_tol = params.termination_rotation_deg.to_radians();
+    let below = |inc: &Increment, factor: f64| {
+        inc.rotation_rad < rot_tol * factor
+            && inc.translation_m < params.termination_translation_m * factor
+    };
+    let mut stride = params.coarse_stride.max(1);
     let mut pose = initial;
-    let mut converged = false;
     let mut iterations = 0;
     let mut last = Increment::default();
+    let mut final_ne = None;
     for it in 0..params.max_iterations {
-        let ne = linearise(&pose);
+        let mut ne = linearise(&pose, stride);
+        if ne.inliers < 6 && stride > 1 {
+            // Too sparse a subset: continue on every point.
+            stride = 1;
+            ne = linearise(&pose, stride);
+        }
         if ne.inliers == 0 {
             return Err(no_match(it));
         }
@@ -39,12 +57,19 @@ pub(crate) fn run(
         pose = pose.oplus(&eps); // T ← ε ⊕ T, Eq. (5)
         iterations = it + 1;
         last = increment_of(&eps);
-        if last.rotation_rad < rot_tol && last.translation_m < params.termination_translation_m {
-            converged = true;
+        if stride == 1 && below(&last, 1.0) {
+            final_ne = Some(ne);
             break;
         }
+        if stride > 1 && below(&last, params.coarse_switch) {
+            stride = 1;
+        }
     }
-    let ne = linearise(&pose);
+    let converged = final_ne.is_some();
+    let ne = match final_ne {
+        Some(ne) => ne,
+        None => linearise(&pose, 1),
+    };
     if ne.inliers == 0 {
         return Err(no_match(iterations));
     }
@@ -53,10 +78,7 @@ pub(crate) fn run(
         t_target_sensor: pose,
         converged,
         iterations,
-        cost: Cost {
-            total: ne.cost,
-            mean: ne.cost / n,
-        },
+        cost: Cost { total: ne.cost, mean: ne.cost / n },
         inliers: ne.inliers,
         valid_points,
         skipped_non_finite,

@@ -12,7 +12,7 @@ use crate::source::{check_pose, finite_positions};
 use nalgebra::Vector3;
 use spacepose_geometry::{Point, Pose};
 
-/// Normal equations of Eq. (7) at `t`: each point `z_i` is associated with
+/// Normal equations of Eq. (7) at `t` over every `stride`-th point: each point `z_i` is associated with
 /// the cell whose smoothed mean is nearest to `T(z_i)` when that mean is
 /// within `max_distance_m` (η of Eq. 3), and contributes
 /// `Jᵢᵀ C⁻¹ Jᵢ` and `Jᵢᵀ C⁻¹ (T(zᵢ) - μ)` with `Jᵢ = [-(R zᵢ)^×  I₃]`.
@@ -20,11 +20,12 @@ pub(crate) fn linearise(
     map: &NdtMap,
     points: &[Vector3<f64>],
     t: &Pose,
+    stride: usize,
     params: &NdtParams,
 ) -> NormalEquations {
     let rotation = t.rotation.matrix();
     let mut ne = NormalEquations::new();
-    for z in points {
+    for z in points.iter().step_by(stride.max(1)) {
         let rz = rotation * z;
         let x = rz + t.translation;
         if let Some((k, _)) = map.nearest_cell(&x, params.max_distance_m, params.lookup) {
@@ -60,7 +61,7 @@ pub fn register_ndt(
         params,
         points.len(),
         skipped,
-        |t| linearise(map, &points, t, params),
+        |t, stride| linearise(map, &points, t, stride, params),
     )
 }
 

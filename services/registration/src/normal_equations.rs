@@ -54,9 +54,32 @@ impl NormalEquations {
 
     /// Adds a rigid term, `J = [-(R z)^×  I₃]` (Eq. 6), with `rz = R z`.
     #[inline(always)]
+    ///
+    /// Uses the structure of `J`: with `A = -(R z)^×`, `AᵀP = [a × P_c]`
+    /// column by column and `AᵀPA = [a × (AᵀP)ᵀ_c]`, so each block costs
+    /// three cross products instead of a 3×3 product.
     pub(crate) fn add_rigid(&mut self, rz: &Vector3<f64>, p: &Matrix3<f64>, r: &Vector3<f64>) {
-        let a = Matrix3::new(0.0, rz.z, -rz.y, -rz.z, 0.0, rz.x, rz.y, -rz.x, 0.0);
-        self.add(&a, 1.0, p, r);
+        let pr = p * r;
+        // M = Aᵀ P = (R z)^× P, the top-right block.
+        let m = Matrix3::from_columns(&[
+            rz.cross(&p.column(0)),
+            rz.cross(&p.column(1)),
+            rz.cross(&p.column(2)),
+        ]);
+        // Aᵀ P A = (R z)^× Mᵀ.
+        let mt = m.transpose();
+        self.h_rr += Matrix3::from_columns(&[
+            rz.cross(&mt.column(0)),
+            rz.cross(&mt.column(1)),
+            rz.cross(&mt.column(2)),
+        ]);
+        self.h_rt += m;
+        self.h_tt += p;
+        self.g_r += rz.cross(&pr);
+        self.g_t += pr;
+        self.cost += r.dot(&pr);
+        self.squared_distance += r.norm_squared();
+        self.inliers += 1;
     }
 
     /// `H = Σ JᵀPJ`, the information matrix in the `δ = [rot; trans]` order.

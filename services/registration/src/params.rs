@@ -122,6 +122,13 @@ pub struct NdtParams {
     pub termination_translation_m: f64,
     /// Nearest-cell search structure.
     pub lookup: CellLookup,
+    /// Speed-up, not in the paper: the first Gauss-Newton increments use
+    /// only every `coarse_stride`-th point (1 disables the coarse phase).
+    pub coarse_stride: usize,
+    /// The coarse phase ends once an increment is below this multiple of
+    /// the termination thresholds; later iterations and the convergence
+    /// test use every point.
+    pub coarse_switch: f64,
 }
 
 impl Default for NdtParams {
@@ -132,6 +139,8 @@ impl Default for NdtParams {
             termination_rotation_deg: 0.05,
             termination_translation_m: 0.001,
             lookup: CellLookup::Grid,
+            coarse_stride: 4,
+            coarse_switch: 5.0,
         }
     }
 }
@@ -142,8 +151,12 @@ impl NdtParams {
         check_positive("max_distance_m", self.max_distance_m)?;
         check_positive("termination_rotation_deg", self.termination_rotation_deg)?;
         check_positive("termination_translation_m", self.termination_translation_m)?;
+        check_positive("coarse_switch", self.coarse_switch)?;
         if self.max_iterations == 0 {
             return Err(RegistrationError::param("max_iterations", "must be >= 1"));
+        }
+        if self.coarse_stride == 0 {
+            return Err(RegistrationError::param("coarse_stride", "must be >= 1"));
         }
         Ok(())
     }

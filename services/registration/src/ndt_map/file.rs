@@ -164,6 +164,8 @@ impl NdtMap {
         }
         body.grid.check(n)?;
         let means: Vec<Vector3<f64>> = body.means.iter().map(|m| Vector3::from(*m)).collect();
+        let mut grid = body.grid;
+        grid.pack(&means);
         let tree = build_tree(&means).map_err(|e| e.to_string())?;
         Ok(Self {
             params: body.params,
@@ -172,7 +174,7 @@ impl NdtMap {
             covariances: body.covariances.iter().map(array_to_sym).collect(),
             inv_covariances: body.inv_covariances.iter().map(array_to_sym).collect(),
             counts: body.counts,
-            grid: body.grid,
+            grid,
             tree,
         })
     }

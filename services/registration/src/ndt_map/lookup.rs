@@ -30,6 +30,20 @@ pub(crate) struct LookupGrid {
     pub offsets: Vec<u32>,
     /// Concatenated candidate cell indices.
     pub candidates: Vec<u32>,
+    /// `candidates` with each cell's mean copied alongside, so a lookup
+    /// reads one contiguous run (rebuilt by [`LookupGrid::pack`], not
+    /// stored).
+    #[serde(skip)]
+    pub packed: Vec<Candidate>,
+}
+
+/// A candidate cell and its mean.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Candidate {
+    /// Mean of the cell.
+    pub mean: [f64; 3],
+    /// Index of the cell.
+    pub cell: u32,
 }
 
 /// Squared distance from `p` to the box `[lo, lo + h]³` (0 inside), and to
@@ -82,8 +96,11 @@ impl LookupGrid {
             max_distance,
             offsets: Vec::new(),
             candidates: Vec::new(),
+            packed: Vec::new(),
         };
         grid.fill(means);
+        grid.prune_dominated(means);
+        grid.pack(means);
         grid
     }
 
@@ -168,10 +185,81 @@ impl LookupGrid {
         self.candidates = candidates;
     }
 
+    /// Drops every candidate that another candidate of the same voxel
+    /// dominates over the whole voxel: `|q - μ_j| ≤ |q - μ_k|` at the eight
+    /// corners, hence (half-spaces being convex) everywhere in the voxel.
+    /// Ties (equal at every corner) keep the lower index. Whenever `k` was
+    /// the nearest cell within `d_max`, a surviving `j` is at least as near,
+    /// so the search stays exact (up to the choice among equidistant cells).
+    fn prune_dominated(&mut self, means: &[Vector3<f64>]) {
+        let n = self.voxel_count();
+        let mut offsets = Vec::with_capacity(n + 1);
+        let mut kept = Vec::with_capacity(self.candidates.len());
+        offsets.push(0u32);
+        let (nx, ny) = (self.dims[0] as usize, self.dims[1] as usize);
+        let h = self.resolution;
+        for v in 0..n {
+            let list = &self.candidates[self.offsets[v] as usize..self.offsets[v + 1] as usize];
+            if list.len() > 1 {
+                let (ix, iy, iz) = (v % nx, (v / nx) % ny, v / (nx * ny));
+                let lo = Vector3::new(
+                    self.origin[0] + ix as f64 * h,
+                    self.origin[1] + iy as f64 * h,
+                    self.origin[2] + iz as f64 * h,
+                );
+                let corners: [Vector3<f64>; 8] = std::array::from_fn(|c| {
+                    lo + Vector3::new(
+                        (c & 1) as f64 * h,
+                        ((c >> 1) & 1) as f64 * h,
+                        ((c >> 2) & 1) as f64 * h,
+                    )
+                });
+                for &k in list {
+                    let mk = &means[k as usize];
+                    let dominated = list.iter().any(|&j| {
+                        if j == k {
+                            return false;
+                        }
+                        let mj = &means[j as usize];
+                        let mut strict = false;
+                        for q in &corners {
+                            let (dj, dk) = ((q - mj).norm_squared(), (q - mk).norm_squared());
+                            if dj > dk {
+                                return false;
+                            }
+                            strict |= dj < dk;
+                        }
+                        strict || j < k
+                    });
+                    if !dominated {
+                        kept.push(k);
+                    }
+                }
+            } else {
+                kept.extend_from_slice(list);
+            }
+            offsets.push(kept.len() as u32);
+        }
+        self.offsets = offsets;
+        self.candidates = kept;
+    }
+
+    /// Rebuilds [`LookupGrid::packed`] from the cell means.
+    pub(crate) fn pack(&mut self, means: &[Vector3<f64>]) {
+        self.packed = self
+            .candidates
+            .iter()
+            .map(|&k| {
+                let m = &means[k as usize];
+                Candidate { mean: [m.x, m.y, m.z], cell: k }
+            })
+            .collect();
+    }
+
     /// The candidate cells of the voxel containing `q` (empty outside the
     /// grid or for a non-finite `q`).
     #[inline]
-    pub(crate) fn candidates_at(&self, q: &Vector3<f64>) -> &[u32] {
+    pub(crate) fn candidates_at(&self, q: &Vector3<f64>) -> &[Candidate] {
         let inv_h = 1.0 / self.resolution;
         let fx = (q.x - self.origin[0]) * inv_h;
         let fy = (q.y - self.origin[1]) * inv_h;
@@ -188,7 +276,7 @@ impl LookupGrid {
             return &[];
         }
         let v = self.index(ix as u32, iy as u32, iz as u32);
-        &self.candidates[self.offsets[v] as usize..self.offsets[v + 1] as usize]
+        &self.packed[self.offsets[v] as usize..self.offsets[v + 1] as usize]
     }
 
     /// Checks the internal consistency of a decoded grid against the number

@@ -202,10 +202,11 @@ impl NdtMap {
         let max2 = max_distance_m * max_distance_m;
         if lookup == CellLookup::Grid && max_distance_m <= self.grid.max_distance {
             let mut best = (usize::MAX, max2);
-            for &k in self.grid.candidates_at(q) {
-                let d2 = (self.means[k as usize] - q).norm_squared();
+            for c in self.grid.candidates_at(q) {
+                let (dx, dy, dz) = (c.mean[0] - q.x, c.mean[1] - q.y, c.mean[2] - q.z);
+                let d2 = dx * dx + dy * dy + dz * dz;
                 if d2 <= best.1 {
-                    best = (k as usize, d2);
+                    best = (c.cell as usize, d2);
                 }
             }
             return (best.0 != usize::MAX).then_some(best);
