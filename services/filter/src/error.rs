@@ -41,4 +41,13 @@ pub enum FilterError {
         /// Index of the point in the input slice.
         index: usize,
     },
+    /// A message from the bus could not be read (bad quaternion, unknown
+    /// code, non-finite value); `what` names the message.
+    #[error("invalid {what} message: {reason}")]
+    InvalidMessage {
+        /// Which message was refused.
+        what: &'static str,
+        /// Why.
+        reason: String,
+    },
 }

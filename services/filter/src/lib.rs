@@ -9,6 +9,9 @@
 //!   information matrix and a Mahalanobis innovation gate.
 //! - [`motion_compensation`]: un-blurring of a scan with the predicted motion
 //!   (Eq. 12).
+//! - [`wire`]: conversions to and from the suite's messages (`FilterState`,
+//!   `PoseEstimate`, `AcquisitionResult`); [`selector`]: one estimate per
+//!   frame; [`service`]: the logic of the `spacepose-filter` binary, bus-free.
 //!
 //! Units SI. `R = r_sensor_target` (target body → sensor), `p = p_sensor` the
 //! target origin in the sensor frame, `v_sensor = dp/dt` in the sensor frame,
@@ -22,6 +25,9 @@ pub mod filter;
 pub mod kalman;
 pub mod motion_compensation;
 pub mod position;
+pub mod selector;
+pub mod service;
+pub mod wire;
 
 pub use attitude::AttitudeFilter;
 pub use config::FilterConfig;
@@ -29,3 +35,5 @@ pub use error::FilterError;
 pub use filter::{Prediction, RelativeMotionFilter, UpdateOutcome, covariance_from_information};
 pub use motion_compensation::MotionCompensation;
 pub use position::PositionFilter;
+pub use selector::{EstimateSelector, Selection};
+pub use service::{EstimateOutcome, FilterNode, FilterServiceConfig};

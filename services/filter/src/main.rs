@@ -1,0 +1,170 @@
+//! `spacepose-filter`: the authority on the relative motion.
+//!
+//! Subscribes to the trackers' `PoseEstimate`s and to `AcquisitionResult`s,
+//! initialises on an accepted acquisition, fuses one `tracking` estimate per
+//! frame and publishes the `FilterState` after every change and every
+//! `state_period_ms` (heartbeat for late joiners). Logic: [`FilterNode`].
+
+use anyhow::Context;
+use clap::Parser;
+use serde::Deserialize;
+use spacepose_bus::{Bus, Publisher, Subscriber, WakeReason};
+use spacepose_filter::{FilterError, FilterNode, FilterServiceConfig};
+use spacepose_messages::{AcquisitionResult, FilterState, Names, PoseEstimate, ServiceState};
+use spacepose_service_kit::{
+    Counters, HealthReporter, ServiceArgs, ServiceConfig, init_logging, load_config, shutdown_flag,
+};
+use std::process::ExitCode;
+use std::sync::atomic::Ordering;
+use std::time::{Duration, Instant};
+
+const SERVICE: &str = "filter";
+
+/// The service configuration as a TOML file ([`FilterServiceConfig`]).
+#[derive(Debug, Default, Deserialize)]
+#[serde(transparent)]
+struct Config(FilterServiceConfig);
+
+impl ServiceConfig for Config {
+    fn validate(&self) -> Result<(), String> {
+        self.0.validate().map_err(|e| e.to_string())
+    }
+}
+
+fn main() -> ExitCode {
+    match run(ServiceArgs::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            tracing::error!("{e:#}");
+            eprintln!("spacepose-filter: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+struct Ports {
+    estimates: Subscriber<PoseEstimate>,
+    acquisitions: Subscriber<AcquisitionResult>,
+    states: Publisher<FilterState>,
+}
+
+fn run(args: ServiceArgs) -> anyhow::Result<()> {
+    init_logging(SERVICE);
+    let Config(config) = load_config(args.config.as_deref())?;
+    let names = Names::new(&args.prefix).context("deployment prefix")?;
+    let instance = args.instance_or(SERVICE);
+    let shutdown = shutdown_flag();
+    let bus = Bus::open(&names, &instance).context("opening the bus")?;
+    let ports = Ports {
+        estimates: bus.subscriber(&names.pose())?,
+        acquisitions: bus.subscriber(&names.acquisition())?,
+        states: bus.publisher(&names.filter_state())?,
+    };
+    let heartbeat = Duration::from_millis(args.heartbeat_ms.max(1));
+    let mut health = HealthReporter::new(&bus, &names, SERVICE, &instance, heartbeat)?;
+    let mut waiter = bus.waitset()?;
+    waiter.attach(&ports.estimates)?;
+    waiter.attach(&ports.acquisitions)?;
+    let mut node = FilterNode::new(&config)?;
+    let mut counters = Counters::default();
+    let state_period =
+        (config.state_period_ms > 0).then(|| Duration::from_millis(config.state_period_ms));
+    let mut last_state = Instant::now();
+    tracing::info!(prefix = names.prefix(), instance, "filter service running");
+    while !shutdown.load(Ordering::Relaxed) {
+        let timeout = state_period.map_or(heartbeat, |p| p.min(heartbeat));
+        if waiter.wait(timeout)? == WakeReason::TerminationRequested {
+            break;
+        }
+        let mut changed = drain_acquisitions(&ports, &mut node, &mut counters);
+        changed |= drain_estimates(&ports, &mut node, &mut counters);
+        if changed || state_period.is_some_and(|p| last_state.elapsed() >= p) {
+            publish(&ports, &node, &mut counters);
+            last_state = Instant::now();
+        }
+        let state = if node.filter().is_initialized() {
+            ServiceState::Running
+        } else {
+            ServiceState::Degraded
+        };
+        health.tick(&counters, state as u8)?;
+    }
+    tracing::info!("filter service stopping");
+    health.send(&counters, ServiceState::Stopping as u8)?;
+    Ok(())
+}
+
+fn publish(ports: &Ports, node: &FilterNode, counters: &mut Counters) {
+    match ports.states.send(&node.state()) {
+        Ok(()) => counters.frames_out += 1,
+        Err(e) => {
+            counters.errors += 1;
+            tracing::warn!("publishing the filter state: {e}");
+        }
+    }
+}
+
+/// Returns whether an acquisition (re)initialised the filter.
+fn drain_acquisitions(ports: &Ports, node: &mut FilterNode, counters: &mut Counters) -> bool {
+    let mut changed = false;
+    loop {
+        let a = match ports.acquisitions.try_recv() {
+            Ok(Some(a)) => a,
+            Ok(None) => return changed,
+            Err(e) => {
+                counters.errors += 1;
+                tracing::warn!("receiving an acquisition: {e}");
+                return changed;
+            }
+        };
+        match node.on_acquisition(&a) {
+            Ok(true) => {
+                tracing::info!(
+                    sequence = a.sequence,
+                    t_s = a.t_s,
+                    "initialised by an acquisition"
+                );
+                changed = true;
+            }
+            Ok(false) => tracing::info!(sequence = a.sequence, "failed acquisition ignored"),
+            Err(e) => {
+                counters.rejected_wire += 1;
+                tracing::warn!("acquisition refused: {e}");
+            }
+        }
+    }
+}
+
+/// Returns whether an estimate changed the state.
+fn drain_estimates(ports: &Ports, node: &mut FilterNode, counters: &mut Counters) -> bool {
+    let mut changed = false;
+    loop {
+        let e = match ports.estimates.try_recv() {
+            Ok(Some(e)) => e,
+            Ok(None) => return changed,
+            Err(err) => {
+                counters.errors += 1;
+                tracing::warn!("receiving an estimate: {err}");
+                return changed;
+            }
+        };
+        counters.frames_in += 1;
+        counters.last_frame = e.sequence;
+        match node.on_estimate(&e) {
+            Ok(outcome) => {
+                changed |= outcome.changed_state();
+                if !outcome.changed_state() {
+                    tracing::debug!(sequence = e.sequence, ?outcome, "estimate not fused");
+                }
+            }
+            Err(err @ FilterError::InvalidMessage { .. }) => {
+                counters.rejected_non_finite += 1;
+                tracing::warn!(sequence = e.sequence, "estimate refused: {err}");
+            }
+            Err(err) => {
+                counters.errors += 1;
+                tracing::warn!(sequence = e.sequence, "filter update failed: {err}");
+            }
+        }
+    }
+}
