@@ -55,13 +55,12 @@ pub fn interpolate(start: &Pose, end: &Pose, u: f64) -> Pose {
     )
 }
 
-/// `Exp(x)` and `D_exp(x)` (seed 000 Eq. 4 and A4) from one `sin_cos`:
-/// `Exp = I + a K + b K²`, `D_exp = I + b K + c K²` with `K = x^×`,
-/// `a = sin θ/θ`, `b = (1 - cos θ)/θ²`, `c = (θ - sin θ)/θ³`.
+/// The coefficients `a = sin θ/θ`, `b = (1 - cos θ)/θ²`, `c = (θ - sin θ)/θ³`
+/// of `Exp(x) = I + a x^× + b (x^×)²` and `D_exp(x) = I + b x^× + c (x^×)²`
+/// (seed 000 Eq. 4 and A4), from `θ² = |x|²`, with one `sin_cos`.
 #[inline]
-fn exp_and_d_exp(x: &Vector3<f64>) -> (Matrix3<f64>, Matrix3<f64>) {
-    let theta2 = x.norm_squared();
-    let (a, b, c) = if theta2 < 1e-10 {
+fn exp_coefficients(theta2: f64) -> (f64, f64, f64) {
+    if theta2 < 1e-10 {
         (
             1.0 - theta2 / 6.0,
             0.5 - theta2 / 24.0,
@@ -75,49 +74,62 @@ fn exp_and_d_exp(x: &Vector3<f64>) -> (Matrix3<f64>, Matrix3<f64>) {
             (1.0 - co) / theta2,
             (theta - s) / (theta2 * theta),
         )
-    };
-    let k = so3::hat(x);
-    let k2 = k * k;
-    let id = Matrix3::identity();
-    (id + k * a + k2 * b, id + k * b + k2 * c)
+    }
 }
 
 /// What every point shares within one linearisation at `T^e`.
 struct Interpolation {
-    r_start: Matrix3<f64>,
     p_start: Vector3<f64>,
     p_end: Vector3<f64>,
-    /// `Log Q`, `Q = R^e (R^s)⁻¹`.
+    /// `φ = Log Q`, `Q = R^e (R^s)⁻¹`.
     phi: Vector3<f64>,
-    /// `D_log(Q)`.
-    d_log_q: Matrix3<f64>,
+    /// `D_log(Q)`, `φ^× D_log(Q)` and `(φ^×)² D_log(Q)`: with
+    /// `D_exp(uφ) = I + b u φ^× + c u² (φ^×)²`, the product
+    /// `D_exp(uφ) D_log(Q)` is a per-point combination of these three.
+    l0: Matrix3<f64>,
+    l1: Matrix3<f64>,
+    l2: Matrix3<f64>,
 }
 
 impl Interpolation {
     fn new(start: &Pose, end: &Pose) -> Self {
         let phi = so3::log(&(end.rotation * start.rotation.inverse()));
+        let k = so3::hat(&phi);
+        let l0 = so3::d_exp_inv(&phi);
+        let l1 = k * l0;
         Self {
-            r_start: *start.rotation.matrix(),
             p_start: start.translation,
             p_end: end.translation,
             phi,
-            d_log_q: so3::d_exp_inv(&phi),
+            l0,
+            l1,
+            l2: k * l1,
         }
     }
 
-    /// `(R^u z, T_u(z), D_exp(u Log Q))` for one point.
+    /// `(R^u z, T_u(z), D_exp(u Log Q) D_log(Q))` for one point given
+    /// `w = R^s z`: `R^u z = Exp(uφ) w` by Rodrigues on the vector.
     #[inline]
-    fn apply(&self, z: &Vector3<f64>, u: f64) -> (Vector3<f64>, Vector3<f64>, Matrix3<f64>) {
-        let (exp_u, d_exp_u) = exp_and_d_exp(&(self.phi * u));
-        let rz = exp_u * (self.r_start * z);
-        let x = rz + self.p_start * (1.0 - u) + self.p_end * u;
-        (rz, x, d_exp_u)
+    fn apply(&self, w: &Vector3<f64>, u: f64) -> (Vector3<f64>, Vector3<f64>, Matrix3<f64>) {
+        let x = self.phi * u;
+        let (a, b, c) = exp_coefficients(x.norm_squared());
+        let xw = x.cross(w);
+        let rz = w + xw * a + x.cross(&xw) * b;
+        let point = rz + self.p_start * (1.0 - u) + self.p_end * u;
+        let d = self.l0 + self.l1 * (b * u) + self.l2 * (c * u * u);
+        (rz, point, d)
     }
 
-    /// Rotation block of Eq. (15): `-(R^u z)^× u D_exp(u Log Q) D_log(Q)`.
+    /// Rotation block of Eq. (15): `-(R^u z)^× u D_exp(u Log Q) D_log(Q)`,
+    /// column by column as cross products.
     #[inline]
-    fn rotation_block(&self, rz: &Vector3<f64>, d_exp_u: &Matrix3<f64>, u: f64) -> Matrix3<f64> {
-        -so3::hat(rz) * (d_exp_u * self.d_log_q) * u
+    fn rotation_block(rz: &Vector3<f64>, d_exp_d_log: &Matrix3<f64>, u: f64) -> Matrix3<f64> {
+        let m = d_exp_d_log * (-u);
+        Matrix3::from_columns(&[
+            rz.cross(&m.column(0)),
+            rz.cross(&m.column(1)),
+            rz.cross(&m.column(2)),
+        ])
     }
 }
 
@@ -125,10 +137,10 @@ impl Interpolation {
 /// perturbation `δ ⊕ T^e`, `δ = [rot; trans]`.
 pub fn ct_point_jacobian(start: &Pose, end: &Pose, u: f64, z: &Vector3<f64>) -> Matrix3x6<f64> {
     let interp = Interpolation::new(start, end);
-    let (rz, _, d_exp_u) = interp.apply(z, u);
+    let (rz, _, d) = interp.apply(&(start.rotation * z), u);
     let mut j = Matrix3x6::zeros();
     j.fixed_view_mut::<3, 3>(0, 0)
-        .copy_from(&interp.rotation_block(&rz, &d_exp_u, u));
+        .copy_from(&Interpolation::rotation_block(&rz, &d, u));
     j.fixed_view_mut::<3, 3>(0, 3)
         .copy_from(&(Matrix3::identity() * u));
     j
@@ -145,16 +157,13 @@ fn linearise(
 ) -> NormalEquations {
     let interp = Interpolation::new(start, end);
     let mut ne = NormalEquations::new();
-    for (z, u) in points.iter().step_by(stride.max(1)) {
-        let (rz, x, d_exp_u) = interp.apply(z, *u);
+    // `points` holds `(R^s z, u)`.
+    for (w, u) in points.iter().step_by(stride.max(1)) {
+        let (rz, x, d) = interp.apply(w, *u);
         if let Some((k, _)) = map.nearest_cell(&x, params.max_distance_m, params.lookup) {
             let (mean, information) = map.mean_and_information(k);
-            ne.add(
-                &interp.rotation_block(&rz, &d_exp_u, *u),
-                *u,
-                information,
-                &(x - mean),
-            );
+            let a = Interpolation::rotation_block(&rz, &d, *u);
+            ne.add(&a, *u, information, &(x - mean));
         }
     }
     ne
@@ -190,7 +199,13 @@ pub fn register_ct_ndt(
     let points: Vec<(Vector3<f64>, f64)> = source
         .iter()
         .filter(|p| position_is_finite(p) && p.t.is_finite())
-        .map(|p| (p.position(), scan.factor(p.t)))
+        // Precomputed `w = R^s z`, fixed through the iterations.
+        .map(|p| {
+            (
+                t_target_sensor_start.rotation * p.position(),
+                scan.factor(p.t),
+            )
+        })
         .collect();
     if points.is_empty() {
         return Err(RegistrationError::AllPointsNonFinite {

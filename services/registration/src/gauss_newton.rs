@@ -78,7 +78,10 @@ pub(crate) fn run(
         t_target_sensor: pose,
         converged,
         iterations,
-        cost: Cost { total: ne.cost, mean: ne.cost / n },
+        cost: Cost {
+            total: ne.cost,
+            mean: ne.cost / n,
+        },
         inliers: ne.inliers,
         valid_points,
         skipped_non_finite,

@@ -169,12 +169,21 @@ fn information_is_the_hessian_at_the_solution() {
     // increment (< 0.05°, < 1 mm) of the returned pose.
     let ne = linearise(map(), &reg_points(), &reg.t_target_sensor, 1, &p);
     let h = ne.hessian();
-    assert!((reg.information - h).norm() <= 0.05 * h.norm(), "{} vs {}", reg.information, h);
+    assert!(
+        (reg.information - h).norm() <= 0.05 * h.norm(),
+        "{} vs {}",
+        reg.information,
+        h
+    );
     assert!(reg.information.cholesky().is_some());
     assert!((reg.cost.total - ne.cost).abs() < 0.05 * ne.cost);
     assert!((reg.cost.mean * reg.inliers as f64 - reg.cost.total).abs() < 1e-9);
     // Not converged (one iteration allowed): evaluated at the returned pose.
-    let one = NdtParams { max_iterations: 1, coarse_stride: 1, ..p };
+    let one = NdtParams {
+        max_iterations: 1,
+        coarse_stride: 1,
+        ..p
+    };
     let start = perturb(&truth, 0.05, 0.05, &mut rng(5));
     let reg = register_ndt(map(), frame(), &start, &one).unwrap();
     assert!(!reg.converged);
@@ -231,43 +240,4 @@ fn bad_input_is_an_error_value() {
         register_ndt(map(), two, &truth, &p),
         Err(RegistrationError::DegenerateSystem { .. })
     ));
-}
-
-#[test]
-fn diag_timing() {
-    if std::env::var("DIAG").is_err() {
-        return;
-    }
-    let truth = true_t_sensor_target().inverse();
-    let pts = reg_points();
-    let p = NdtParams::default();
-    let map = map();
-    let n = 300;
-    println!("{:?}", map.stats());
-    let t0 = std::time::Instant::now();
-    let mut acc = Vector3::zeros();
-    for _ in 0..n {
-        for z in &pts {
-            acc += truth.transform(z);
-        }
-    }
-    println!("transform only {:.3} ms {acc}", t0.elapsed().as_secs_f64() / n as f64 * 1e3);
-    let t0 = std::time::Instant::now();
-    let mut hits = 0usize;
-    for _ in 0..n {
-        for z in &pts {
-            let x = truth.transform(z);
-            if map.nearest_cell(&x, 0.075, CellLookup::Grid).is_some() {
-                hits += 1;
-            }
-        }
-    }
-    let lookup = t0.elapsed().as_secs_f64() / n as f64;
-    let t0 = std::time::Instant::now();
-    let mut c = 0.0;
-    for _ in 0..n {
-        c += linearise(map, &pts, &truth, 1, &p).cost;
-    }
-    let lin = t0.elapsed().as_secs_f64() / n as f64;
-    println!("{} pts: lookup pass {:.3} ms, linearise {:.3} ms ({hits} {c})", pts.len(), lookup * 1e3, lin * 1e3);
 }

@@ -251,7 +251,10 @@ impl LookupGrid {
             .iter()
             .map(|&k| {
                 let m = &means[k as usize];
-                Candidate { mean: [m.x, m.y, m.z], cell: k }
+                Candidate {
+                    mean: [m.x, m.y, m.z],
+                    cell: k,
+                }
             })
             .collect();
     }
@@ -282,8 +285,7 @@ impl LookupGrid {
     /// Checks the internal consistency of a decoded grid against the number
     /// of cells; returns a description of the first problem found.
     pub(crate) fn check(&self, cells: usize) -> Result<(), String> {
-        if !(self.resolution.is_finite() && self.resolution > 0.0)
-            || !self.max_distance.is_finite()
+        if !(self.resolution.is_finite() && self.resolution > 0.0 && self.max_distance.is_finite())
             || self.origin.iter().any(|o| !o.is_finite())
             || self.dims.contains(&0)
         {

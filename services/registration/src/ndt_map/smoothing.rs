@@ -18,6 +18,9 @@ pub(crate) struct RawCell {
     pub centre: Vector3<f64>,
 }
 
+/// A mean and a covariance.
+pub(crate) type Gaussian = (Vector3<f64>, Matrix3<f64>);
+
 /// Smooths every cell: cell `k` is replaced by the aggregate (Eq. 1) of all
 /// cells whose mean lies within `radius` of its centre `c_k`, with weights
 /// `w ∝ n exp(-|μ - c_k|² / 2σ²)` (Eq. 2), normalised to sum to one.
@@ -30,7 +33,7 @@ pub(crate) fn smooth(
     cells: &[RawCell],
     sigma: f64,
     radius: f64,
-) -> Result<Vec<(Vector3<f64>, Matrix3<f64>)>, RegistrationError> {
+) -> Result<Vec<Gaussian>, RegistrationError> {
     let means: Vec<Vector3<f64>> = cells.iter().map(|c| c.mean).collect();
     let tree = build_tree(&means)?;
     let inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
