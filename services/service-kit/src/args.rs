@@ -18,6 +18,12 @@ pub struct ServiceArgs {
     /// Heartbeat period of the health message (ms).
     #[arg(long, default_value_t = 500)]
     pub heartbeat_ms: u64,
+    /// Only check the configuration: [`crate::load_config`] loads and
+    /// validates it, prints `configuration ok` and exits with status 0 (or
+    /// the service fails with the error) before the bus is touched.
+    /// `spacepose up` uses it to validate a descriptor before starting anything.
+    #[arg(long)]
+    pub check: bool,
 }
 
 impl ServiceArgs {
@@ -54,5 +60,6 @@ mod tests {
         assert_eq!((a.prefix.as_str(), a.heartbeat_ms), ("t1", 50));
         assert_eq!(a.instance_or("ingest"), "ingest-b");
         assert!(ServiceArgs::try_parse_from(["x", "--bogus"]).is_err());
+        assert!(ServiceArgs::try_parse_from(["x", "--check"]).unwrap().check);
     }
 }

@@ -13,10 +13,31 @@ pub trait ServiceConfig: DeserializeOwned + Default {
 
 /// Loads and validates the configuration at `path` (defaults when `None`).
 ///
+/// When the process was started with `--check` ([`crate::ServiceArgs::check`]),
+/// a valid configuration prints `configuration ok` and ends the process with
+/// status 0 here, before the service opens the bus; an invalid one is
+/// returned as the error, as without `--check`.
+///
 /// # Errors
 /// The file cannot be read, is not valid TOML for `C` (unknown keys
 /// included), or fails [`ServiceConfig::validate`]; the message names the file.
 pub fn load_config<C: ServiceConfig>(path: Option<&Path>) -> anyhow::Result<C> {
+    let config = read_config(path)?;
+    if check_requested(std::env::args_os()) {
+        println!("configuration ok");
+        std::process::exit(0);
+    }
+    Ok(config)
+}
+
+/// True when the command line holds `--check`. The flag is declared in
+/// [`crate::ServiceArgs`], so clap has already refused malformed command lines.
+fn check_requested(mut args: impl Iterator<Item = std::ffi::OsString>) -> bool {
+    args.next();
+    args.any(|a| a == "--check")
+}
+
+fn read_config<C: ServiceConfig>(path: Option<&Path>) -> anyhow::Result<C> {
     let Some(path) = path else {
         let config = C::default();
         if let Err(e) = config.validate() {
@@ -66,6 +87,18 @@ mod tests {
                 ))
             }
         }
+    }
+
+    #[test]
+    fn check_is_requested_by_the_flag_only() {
+        let args = |v: &[&str]| v.iter().map(std::ffi::OsString::from).collect::<Vec<_>>();
+        assert!(check_requested(
+            args(&["svc", "--config", "c.toml", "--check"]).into_iter()
+        ));
+        assert!(!check_requested(
+            args(&["svc", "--config", "c.toml"]).into_iter()
+        ));
+        assert!(!check_requested(args(&["--check"]).into_iter()));
     }
 
     #[test]
