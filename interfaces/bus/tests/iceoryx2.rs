@@ -1,5 +1,7 @@
 //! iceoryx2 transport: clouds, messages, wake-up, capacity, isolation, cleanup.
 
+#![allow(clippy::unwrap_used)] // tests may unwrap
+
 mod common;
 
 use common::unique_names;

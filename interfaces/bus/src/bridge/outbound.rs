@@ -143,6 +143,9 @@ fn forwarder(
     }
 }
 
+/// The worker's node, forwarders and waiter (the node must outlive the ports).
+type Ports = (Bus, Vec<Box<dyn Forward>>, Waiter);
+
 /// The outbound worker's inputs (everything `Send`; ports are made in the thread).
 pub(crate) struct Worker {
     names: Names,
@@ -169,7 +172,7 @@ impl Worker {
         }
     }
 
-    fn setup(&self) -> Result<(Bus, Vec<Box<dyn Forward>>, Waiter), BusError> {
+    fn setup(&self) -> Result<Ports, BusError> {
         let bus = Bus::open(&self.names, "bridge-out")?;
         let forwarders = self
             .routes

@@ -1,6 +1,6 @@
 //! Helpers shared by the integration tests.
 
-#![allow(dead_code)]
+#![allow(dead_code, clippy::unwrap_used)] // test helpers may unwrap
 
 use spacepose_messages::Names;
 use std::sync::atomic::{AtomicU32, Ordering};
