@@ -36,4 +36,17 @@ pub enum TrackError {
     /// The filter rejected an input (non-finite pose, bad time step).
     #[error("filter failed: {0}")]
     Filter(#[from] FilterError),
+    /// The target model could not be built or loaded (unknown target, bad
+    /// mesh, corrupt or unwritable NDT map file).
+    #[error("tracking model: {0}")]
+    Model(String),
+    /// A message from the bus could not be used (bad quaternion, unknown
+    /// code, non-finite value); `what` names the message.
+    #[error("invalid {what} message: {reason}")]
+    InvalidMessage {
+        /// Which message was refused.
+        what: &'static str,
+        /// Why.
+        reason: String,
+    },
 }

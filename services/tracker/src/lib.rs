@@ -13,6 +13,10 @@
 //! Every frame yields a [`TrackOutput`] carrying the pose, its covariance,
 //! the registration's quality figures, timings and a [`TrackStatus`]
 //! (`tracking`, `degraded`, `lost`): loss is reported, never hidden.
+//!
+//! The `spacepose-tracker` service binary (`src/main.rs`) is a thin loop
+//! over [`TrackerNode`] ([`service`]), configured by
+//! [`TrackerServiceConfig`]; [`wire`] converts to the suite's messages.
 #![forbid(unsafe_code)]
 
 pub mod config;
@@ -21,14 +25,19 @@ pub mod measurement;
 pub mod mode;
 pub mod model;
 pub mod output;
+pub mod service;
+pub mod service_config;
 pub mod status;
 pub mod tracker;
+pub mod wire;
 
 pub use config::{LossConfig, TrackerConfig};
 pub use error::TrackError;
 pub use mode::TrackingMode;
 pub use model::TrackingModel;
 pub use output::{Timings, TrackOutput};
+pub use service::{CommandOutcome, FrameResult, InputIssue, TrackerNode};
+pub use service_config::{MapSource, TrackerServiceConfig};
 pub use status::TrackStatus;
 pub use tracker::Tracker;
 

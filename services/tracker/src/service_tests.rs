@@ -1,0 +1,212 @@
+//! Tests of [`TrackerNode`] on simulated `deos` frames (test seeds).
+
+use super::*;
+use crate::TrackingMode;
+use nalgebra::Vector3;
+use spacepose_lidar_sim::{Frame, LidarSimulator, SensorConfig};
+use spacepose_messages::{WireStatus, realtime_ns};
+use spacepose_registration::NdtMapParams;
+use spacepose_scenario::{ScenarioConfig, ScenarioKind, build};
+use spacepose_target::Target;
+use std::sync::{Arc, OnceLock};
+
+struct Fixture {
+    model: TrackingModel,
+    frames: Vec<Frame>,
+}
+
+fn fixture() -> &'static Fixture {
+    static F: OnceLock<Fixture> = OnceLock::new();
+    F.get_or_init(|| {
+        let target = Arc::new(Target::builtin("deos").unwrap());
+        let model =
+            TrackingModel::build(&target.sample_surface(0.015, 0), &NdtMapParams::default())
+                .unwrap();
+        let mut config = ScenarioConfig::default_for(ScenarioKind::SlowSpin);
+        config.seed = 21;
+        let scenario = build(&config).unwrap();
+        let mut sensor = SensorConfig::livox_mid40();
+        sensor.integration_time_s = 1.0;
+        let sim = LidarSimulator::new(target, sensor).unwrap();
+        let frames = scenario
+            .frame_end_times(4)
+            .iter()
+            .enumerate()
+            .map(|(k, &t)| {
+                sim.simulate(
+                    &scenario.state_at(t),
+                    &mut LidarSimulator::frame_rng(21, k as u64),
+                )
+            })
+            .collect();
+        Fixture { model, frames }
+    })
+}
+
+fn node() -> TrackerNode {
+    let config = TrackerConfig::with_mode(TrackingMode::Ndt);
+    let instance = Name::new("tracker-t").unwrap();
+    TrackerNode::new(config, fixture().model.clone(), instance, 150_000).unwrap()
+}
+
+fn header(seq: u64, f: &Frame) -> CloudHeader {
+    let mut h = CloudHeader::new(seq, f.scan_start, f.scan_end);
+    h.published_ns = realtime_ns();
+    h
+}
+
+fn status(r: &FrameResult) -> WireStatus {
+    r.estimate.wire_status().unwrap()
+}
+
+fn truth_acquisition(f: &Frame) -> AcquisitionResult {
+    let mut a = AcquisitionResult::new();
+    a.success = 1;
+    a.t_s = f.scan_end;
+    a.set_pose(&f.truth.t_sensor_target);
+    a
+}
+
+fn errors(r: &FrameResult, f: &Frame) -> (f64, f64) {
+    let (ang, pos) = r
+        .estimate
+        .pose()
+        .unwrap()
+        .error_to(&f.truth.t_sensor_target);
+    (ang.to_degrees(), pos)
+}
+
+#[test]
+fn frames_before_initialisation_and_bad_frames_are_lost_but_answered() {
+    let f = &fixture().frames;
+    let mut node = node();
+    let r = node.on_cloud(&header(0, &f[0]), &f[0].points);
+    assert_eq!(status(&r), WireStatus::Lost);
+    assert_eq!(r.estimate.sequence, 0);
+    assert!(r.reason.contains("not initialised"), "{}", r.reason);
+    assert!(node.on_acquisition(&truth_acquisition(&f[0])).unwrap());
+
+    let empty = node.on_cloud(&header(1, &f[1]), &[]);
+    assert_eq!(
+        (status(&empty), empty.issue),
+        (WireStatus::Lost, Some(InputIssue::Empty))
+    );
+    let nan = vec![Point::new(f32::NAN, 0.0, 1.0, 1.0, f[1].scan_end); 50];
+    let r = node.on_cloud(&header(1, &f[1]), &nan);
+    assert_eq!(status(&r), WireStatus::Lost);
+    assert_eq!(
+        r.issue,
+        Some(InputIssue::NonFinite {
+            dropped: 50,
+            kept: 0
+        })
+    );
+    let big = vec![f[1].points[0]; 150_001];
+    let r = node.on_cloud(&header(1, &f[1]), &big);
+    assert!(matches!(r.issue, Some(InputIssue::Oversized { .. })));
+
+    // None of that hurt the track: the frame tracks from the acquisition.
+    let r = node.on_cloud(&header(1, &f[1]), &f[1].points);
+    assert_eq!(status(&r), WireStatus::Tracking, "{}", r.reason);
+    let (ang, pos) = errors(&r, &f[1]);
+    assert!(ang < 3.0 && pos < 0.08, "{ang} deg {pos} m");
+    assert!(r.estimate.total_ms > 0.0 && r.estimate.iterations > 0);
+    assert!(r.estimate.covariance[0][0] > 0.0);
+
+    // A few NaN points among good ones are dropped and the frame tracked.
+    let mut some_nan = f[2].points.clone();
+    some_nan[3].x = f32::NAN;
+    some_nan[7].t = f64::INFINITY;
+    let r = node.on_cloud(&header(2, &f[2]), &some_nan);
+    assert_eq!(
+        r.issue,
+        Some(InputIssue::NonFinite {
+            dropped: 2,
+            kept: some_nan.len() - 2
+        })
+    );
+    assert_eq!(status(&r), WireStatus::Tracking, "{}", r.reason);
+    // Going back in time is refused with an error, answered as lost.
+    let r = node.on_cloud(&header(0, &f[0]), &f[0].points);
+    assert_eq!(status(&r), WireStatus::Lost);
+    assert!(matches!(r.error, Some(TrackError::InvalidScanTimes { .. })));
+    let r = node.on_cloud(&header(3, &f[3]), &f[3].points);
+    assert_eq!(status(&r), WireStatus::Tracking, "{}", r.reason);
+}
+
+#[test]
+fn commands_switch_modes_and_reinitialise() {
+    let f = &fixture().frames;
+    let mut node = node();
+    let me = Name::new("tracker-t").unwrap();
+    let ground = Name::new("ground").unwrap();
+    let mut c = Command::new(CommandKind::Mode, ground);
+    c.mode = WireMode::CtNdt as u8;
+    c.target_instance = Name::new("tracker-b").unwrap();
+    assert_eq!(node.on_command(&c).unwrap(), CommandOutcome::NotForMe);
+    c.target_instance = me;
+    assert_eq!(
+        node.on_command(&c).unwrap(),
+        CommandOutcome::ModeSet(WireMode::CtNdt)
+    );
+    assert_eq!(node.tracker().mode(), TrackingMode::CtNdt);
+    c.mode = 9;
+    assert!(node.on_command(&c).is_err());
+
+    let mut reinit = Command::new(CommandKind::Reinit, ground);
+    reinit.set_pose(&f[0].truth.t_sensor_target);
+    assert_eq!(
+        node.on_command(&reinit).unwrap(),
+        CommandOutcome::ReinitFromPose
+    );
+    let r = node.on_cloud(&header(1, &f[1]), &f[1].points);
+    assert_eq!(r.estimate.mode, WireMode::CtNdt as u8);
+    assert_ne!(status(&r), WireStatus::Lost, "{}", r.reason);
+    assert!(node.is_tracking());
+
+    let drop = Command::new(CommandKind::Reinit, ground);
+    assert_eq!(
+        node.on_command(&drop).unwrap(),
+        CommandOutcome::ReinitFromAcquisition
+    );
+    assert!(!node.is_tracking());
+    let r = node.on_cloud(&header(2, &f[2]), &f[2].points);
+    assert_eq!(status(&r), WireStatus::Lost);
+    assert_eq!(node.tracker().mode(), TrackingMode::CtNdt);
+    let swap = Command::new(CommandKind::Swap, ground);
+    assert_eq!(
+        node.on_command(&swap).unwrap(),
+        CommandOutcome::Ignored(CommandKind::Swap)
+    );
+}
+
+#[test]
+fn filter_states_are_followed_once_tracking() {
+    let f = &fixture().frames;
+    let mut node = node();
+    let mut filter = spacepose_filter::RelativeMotionFilter::new(Default::default()).unwrap();
+    filter
+        .initialize(
+            f[1].scan_end,
+            &f[1].truth.t_sensor_target,
+            Vector3::zeros(),
+            Vector3::zeros(),
+        )
+        .unwrap();
+    let state = spacepose_filter::wire::state_of(&filter, 1);
+    // Ignored before initialisation (nothing to follow yet).
+    node.on_filter_state(&state).unwrap();
+    assert!(!node.is_tracking());
+    node.on_acquisition(&truth_acquisition(&f[0])).unwrap();
+    node.on_cloud(&header(1, &f[1]), &f[1].points);
+    node.on_filter_state(&state).unwrap();
+    let p = node.tracker().predict_at(f[1].scan_end).unwrap();
+    let (ang, pos) = p.pose.error_to(&f[1].truth.t_sensor_target);
+    assert!(
+        ang < 1e-9 && pos < 1e-9,
+        "the service's state replaced the local one"
+    );
+    let mut bad = state;
+    bad.p_sensor_target[0] = f64::NAN;
+    assert!(node.on_filter_state(&bad).is_err());
+}
