@@ -23,6 +23,98 @@ pub enum Command {
     /// Evaluate an estimator against ground truth.
     #[command(subcommand)]
     Eval(EvalCommand),
+    /// Start the services of a deployment descriptor and wait for their health.
+    Up(UpArgs),
+    /// Show the instances of running deployments.
+    Status(PrefixArgs),
+    /// Stop a deployment (SIGTERM, then SIGKILL) and clean up after it.
+    Down(PrefixArgs),
+    /// The main job: a simulated tumbling rendezvous through the real service
+    /// processes, scored against truth.
+    Demo(DemoArgs),
+    /// Ground tool: telemetry over zenoh as a live table, optionally recorded.
+    Ground(GroundArgs),
+}
+
+/// zenoh endpoint overrides of a descriptor.
+#[derive(Debug, Clone, Args)]
+pub struct ZenohOverrideArgs {
+    /// Deployment prefix (replaces the descriptor's).
+    #[arg(long)]
+    pub prefix: Option<String>,
+    /// zenoh endpoint the suite listens on (replaces the descriptor's; repeatable).
+    #[arg(long)]
+    pub listen: Vec<String>,
+    /// zenoh endpoint the suite connects to, e.g. a ground tool listening (repeatable).
+    #[arg(long)]
+    pub connect: Vec<String>,
+}
+
+/// `spacepose up`.
+#[derive(Debug, Args)]
+pub struct UpArgs {
+    /// Deployment descriptor (TOML), e.g. deploy/demo.toml.
+    pub deploy: PathBuf,
+    /// Overrides.
+    #[command(flatten)]
+    pub overrides: ZenohOverrideArgs,
+}
+
+/// `spacepose status` / `spacepose down`.
+#[derive(Debug, Args)]
+pub struct PrefixArgs {
+    /// Deployment prefix (default: every deployment for status, the only one for down).
+    #[arg(long)]
+    pub prefix: Option<String>,
+}
+
+/// `spacepose demo`.
+#[derive(Debug, Args)]
+pub struct DemoArgs {
+    /// Deployment descriptor.
+    #[arg(long, default_value = "deploy/demo.toml")]
+    pub deploy: PathBuf,
+    /// Frames to run (lidar-sim's frame count).
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u64).range(1..))]
+    pub frames: u64,
+    /// Frames excluded from the converged error figures (filter warm-up).
+    #[arg(long, default_value_t = 10)]
+    pub warmup: usize,
+    /// Write the summary as JSON.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Seconds to wait for missing poses once the sensor stops.
+    #[arg(long, default_value_t = 5.0)]
+    pub linger_s: f64,
+    /// Overrides (default prefix: a fresh random one).
+    #[command(flatten)]
+    pub overrides: ZenohOverrideArgs,
+}
+
+/// `spacepose ground`.
+#[derive(Debug, Args)]
+pub struct GroundArgs {
+    /// zenoh endpoint of a suite (repeatable; retried until it answers).
+    #[arg(long)]
+    pub connect: Vec<String>,
+    /// Listen on this endpoint instead, for suites that connect to the ground (repeatable).
+    #[arg(long)]
+    pub listen: Vec<String>,
+    /// Deployment prefix; `*` = every deployment.
+    #[arg(long, default_value = "*")]
+    pub prefix: String,
+    /// Append every received message to this file as JSON lines.
+    #[arg(long)]
+    pub record: Option<PathBuf>,
+    /// Stop after this many seconds.
+    #[arg(long)]
+    pub duration: Option<f64>,
+    /// Stop after this many pose messages (exit 1 if --duration ends first).
+    #[arg(long)]
+    pub count: Option<u64>,
+    /// Table refresh period in seconds (0 = only the final table).
+    #[arg(long, default_value_t = 1.0)]
+    pub refresh_s: f64,
 }
 
 /// Evaluations.

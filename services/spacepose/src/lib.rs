@@ -5,5 +5,7 @@
 pub mod cli;
 pub mod common;
 pub mod eval;
+pub mod ground;
 pub mod sim_cmd;
+pub mod suite;
 pub mod truth_csv;

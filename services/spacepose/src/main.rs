@@ -13,6 +13,11 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Sim(args) => spacepose::sim_cmd::run(&args),
         Command::Eval(EvalCommand::Tracking(args)) => spacepose::eval::tracking::run(&args),
+        Command::Up(args) => spacepose::suite::cmd::up(&args),
+        Command::Status(args) => spacepose::suite::cmd::status(&args),
+        Command::Down(args) => spacepose::suite::cmd::down(&args),
+        Command::Demo(args) => spacepose::suite::cmd::demo(&args),
+        Command::Ground(args) => spacepose::suite::cmd::ground(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

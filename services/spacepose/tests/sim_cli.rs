@@ -4,7 +4,10 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 fn spacepose(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_spacepose")).args(args).output().expect("spawn spacepose")
+    Command::new(env!("CARGO_BIN_EXE_spacepose"))
+        .args(args)
+        .output()
+        .expect("spawn spacepose")
 }
 
 fn stderr(o: &Output) -> String {
@@ -15,12 +18,28 @@ fn stderr(o: &Output) -> String {
 fn write_cube_stl(path: &Path) {
     let v = |x: f64, y: f64, z: f64| [x * 1000.0, y * 1000.0, z * 1000.0];
     let c = [
-        v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0., 1., 0.),
-        v(0., 0., 1.), v(1., 0., 1.), v(1., 1., 1.), v(0., 1., 1.),
+        v(0., 0., 0.),
+        v(1., 0., 0.),
+        v(1., 1., 0.),
+        v(0., 1., 0.),
+        v(0., 0., 1.),
+        v(1., 0., 1.),
+        v(1., 1., 1.),
+        v(0., 1., 1.),
     ];
     let faces = [
-        [0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4],
-        [1, 2, 6], [1, 6, 5], [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7],
+        [0, 2, 1],
+        [0, 3, 2],
+        [4, 5, 6],
+        [4, 6, 7],
+        [0, 1, 5],
+        [0, 5, 4],
+        [1, 2, 6],
+        [1, 6, 5],
+        [2, 3, 7],
+        [2, 7, 6],
+        [3, 0, 4],
+        [3, 4, 7],
     ];
     let mut s = String::from("solid cube\n");
     for f in faces {
@@ -31,7 +50,7 @@ fn write_cube_stl(path: &Path) {
         s.push_str("endloop\nendfacet\n");
     }
     s.push_str("endsolid cube\n");
-    std::fs::write(path, s).unwrap();
+    std::fs::write(path, s).expect("writing the cube STL");
 }
 
 #[test]
@@ -39,7 +58,16 @@ fn writes_frames_and_truth_for_a_builtin_target() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
     let o = spacepose(&[
-        "sim", "--target", "deos", "--scenario", "tumbling", "--frames", "3", "--seed", "7", "--out",
+        "sim",
+        "--target",
+        "deos",
+        "--scenario",
+        "tumbling",
+        "--frames",
+        "3",
+        "--seed",
+        "7",
+        "--out",
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -56,10 +84,21 @@ fn writes_frames_and_truth_for_a_builtin_target() {
     let (frame, t_end, p, _q) = spacepose::truth_csv::parse_row(lines[3]).unwrap();
     assert_eq!(frame, 2);
     assert!((t_end - 3.0).abs() < 1e-9);
-    assert!((nalgebra::Vector3::from(p).norm() - 15.0).abs() < 0.5, "tumbling starts at 15 m");
+    assert!(
+        (nalgebra::Vector3::from(p).norm() - 15.0).abs() < 0.5,
+        "tumbling starts at 15 m"
+    );
     // The same seed gives the same frames.
     let again = dir.path().join("again");
-    let o = spacepose(&["sim", "--frames", "1", "--seed", "7", "--out", again.to_str().unwrap()]);
+    let o = spacepose(&[
+        "sim",
+        "--frames",
+        "1",
+        "--seed",
+        "7",
+        "--out",
+        again.to_str().unwrap(),
+    ]);
     assert!(o.status.success());
     assert_eq!(
         std::fs::read(out.join("frame_000000.pcd")).unwrap(),
@@ -74,8 +113,21 @@ fn simulates_a_mesh_file_with_scale() {
     write_cube_stl(&mesh);
     let out = dir.path().join("cube");
     let o = spacepose(&[
-        "sim", "--target", mesh.to_str().unwrap(), "--scale", "0.002", "--scenario", "random", "--range", "8",
-        "--frames", "2", "--out", out.to_str().unwrap(), "--format", "ply",
+        "sim",
+        "--target",
+        mesh.to_str().unwrap(),
+        "--scale",
+        "0.002",
+        "--scenario",
+        "random",
+        "--range",
+        "8",
+        "--frames",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+        "--format",
+        "ply",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let points = spacepose_geometry::read_cloud(out.join("frame_000000.ply")).unwrap();
@@ -96,11 +148,31 @@ fn bad_arguments_give_one_line_errors_and_a_failure_status() {
     std::fs::write(&garbage, b"solid x\nthis is not an stl file\n").unwrap();
     let cases: Vec<Vec<&str>> = vec![
         vec!["sim", "--target", "hubble", "--out", out.to_str().unwrap()],
-        vec!["sim", "--target", missing.to_str().unwrap(), "--out", out.to_str().unwrap()],
-        vec!["sim", "--target", garbage.to_str().unwrap(), "--out", out.to_str().unwrap()],
+        vec![
+            "sim",
+            "--target",
+            missing.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        vec![
+            "sim",
+            "--target",
+            garbage.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
         vec!["sim", "--frames", "0", "--out", out.to_str().unwrap()],
         vec!["sim", "--frames", "-3", "--out", out.to_str().unwrap()],
-        vec!["sim", "--scale", "-1", "--target", garbage.to_str().unwrap(), "--out", out.to_str().unwrap()],
+        vec![
+            "sim",
+            "--scale",
+            "-1",
+            "--target",
+            garbage.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
     ];
     for args in cases {
         let o = spacepose(&args);

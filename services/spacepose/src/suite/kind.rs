@@ -1,0 +1,163 @@
+//! The kinds of service a deployment can start, with the topics each one
+//! reads and publishes (the topic check of a descriptor relies on them).
+
+use serde::{Deserialize, Serialize};
+use spacepose_messages::Topic;
+
+/// A service kind: one binary each.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ServiceKind {
+    /// Simulated sensor (`spacepose-lidar-sim`).
+    LidarSim,
+    /// Replay of a directory of PCD/PLY frames (`spacepose-pcd-replay`).
+    PcdReplay,
+    /// Crop to the region of interest and voxel filter (`spacepose-ingest`).
+    Ingest,
+    /// Pose tracking (`spacepose-tracker`).
+    Tracker,
+    /// Relative-motion filter (`spacepose-filter`).
+    Filter,
+    /// Health, pose and truth to zenoh JSON (`spacepose-telemetry`).
+    Telemetry,
+}
+
+impl ServiceKind {
+    /// Every kind.
+    pub const ALL: [ServiceKind; 6] = [
+        ServiceKind::LidarSim,
+        ServiceKind::PcdReplay,
+        ServiceKind::Ingest,
+        ServiceKind::Tracker,
+        ServiceKind::Filter,
+        ServiceKind::Telemetry,
+    ];
+
+    /// The descriptor spelling (`"lidar-sim"`, ...).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ServiceKind::LidarSim => "lidar-sim",
+            ServiceKind::PcdReplay => "pcd-replay",
+            ServiceKind::Ingest => "ingest",
+            ServiceKind::Tracker => "tracker",
+            ServiceKind::Filter => "filter",
+            ServiceKind::Telemetry => "telemetry",
+        }
+    }
+
+    /// File name of the binary (`"spacepose-lidar-sim"`, ...).
+    pub fn binary_name(self) -> String {
+        format!("spacepose-{}", self.as_str())
+    }
+
+    /// Cargo package that builds the binary.
+    pub fn package(self) -> String {
+        self.binary_name()
+    }
+
+    /// Sources publish frames on their own clock: they start last, once every
+    /// consumer is listening, so no frame is published into the void.
+    pub fn is_source(self) -> bool {
+        matches!(self, ServiceKind::LidarSim | ServiceKind::PcdReplay)
+    }
+
+    /// Topics without which the service cannot do its job: each one needs a
+    /// producer in the descriptor.
+    pub fn required_inputs(self) -> &'static [Topic] {
+        match self {
+            ServiceKind::LidarSim | ServiceKind::PcdReplay => &[],
+            ServiceKind::Ingest => &[Topic::RawCloud],
+            // Until the init service exists (issue 5), the first pose comes
+            // from lidar-sim's truth acquisition (`truth_init = true`).
+            ServiceKind::Tracker => &[Topic::Cloud, Topic::Acquisition],
+            ServiceKind::Filter => &[Topic::Pose],
+            ServiceKind::Telemetry => &[Topic::Health],
+        }
+    }
+
+    /// Topics used when present (their absence degrades, not breaks).
+    pub fn optional_inputs(self) -> &'static [Topic] {
+        match self {
+            ServiceKind::LidarSim | ServiceKind::PcdReplay => &[Topic::Command],
+            ServiceKind::Ingest => &[Topic::FilterState],
+            ServiceKind::Tracker => &[Topic::FilterState, Topic::Command],
+            ServiceKind::Filter => &[Topic::Acquisition, Topic::Command],
+            ServiceKind::Telemetry => &[Topic::Pose, Topic::FilterState, Topic::Truth],
+        }
+    }
+
+    /// Topics published. `truth_init` says whether a lidar-sim publishes the
+    /// truth acquisition of its first frame (its config key `truth_init`).
+    pub fn outputs(self, truth_init: bool) -> Vec<Topic> {
+        let mut out = match self {
+            ServiceKind::LidarSim => vec![Topic::RawCloud, Topic::Truth],
+            ServiceKind::PcdReplay => vec![Topic::RawCloud],
+            ServiceKind::Ingest => vec![Topic::Cloud],
+            ServiceKind::Tracker => vec![Topic::Pose],
+            ServiceKind::Filter => vec![Topic::FilterState],
+            // Commands from the ground come in through telemetry's bridge.
+            ServiceKind::Telemetry => vec![Topic::Command],
+        };
+        if self == ServiceKind::LidarSim && truth_init {
+            out.push(Topic::Acquisition);
+        }
+        out.push(Topic::Health);
+        out
+    }
+
+    /// Kinds that can publish `topic` (for error messages).
+    pub fn producers_of(topic: Topic) -> Vec<ServiceKind> {
+        ServiceKind::ALL
+            .into_iter()
+            .filter(|k| k.outputs(true).contains(&topic))
+            .collect()
+    }
+}
+
+impl std::fmt::Display for ServiceKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_required_input_has_a_possible_producer() {
+        for kind in ServiceKind::ALL {
+            for topic in kind.required_inputs() {
+                assert!(
+                    !ServiceKind::producers_of(*topic).is_empty(),
+                    "{kind} needs {topic:?}"
+                );
+            }
+        }
+        assert_eq!(
+            ServiceKind::producers_of(Topic::Cloud),
+            vec![ServiceKind::Ingest]
+        );
+        assert!(
+            !ServiceKind::LidarSim
+                .outputs(false)
+                .contains(&Topic::Acquisition)
+        );
+        assert!(
+            ServiceKind::LidarSim
+                .outputs(true)
+                .contains(&Topic::Acquisition)
+        );
+    }
+
+    #[test]
+    fn names_round_trip_through_serde() {
+        for kind in ServiceKind::ALL {
+            let v: ServiceKind = toml::Value::String(kind.as_str().into())
+                .try_into()
+                .unwrap();
+            assert_eq!(v, kind);
+            assert_eq!(kind.binary_name(), format!("spacepose-{kind}"));
+        }
+    }
+}

@@ -1,0 +1,247 @@
+//! Starting a planned deployment: consumers first, then the sources, each
+//! stage only once every instance of the previous one has sent a heartbeat.
+//! On any failure, whatever was started is stopped again.
+
+use super::health::HealthWatch;
+use super::plan::{Plan, PlannedInstance};
+use super::process::{is_alive, log_tail, spawn_logged, terminate};
+use super::state::{InstanceState, RunState, run_dir, unix_now_s};
+use anyhow::{Context, Result, bail};
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::Child;
+use std::time::{Duration, Instant};
+
+/// How long a service gets to stop after SIGTERM before SIGKILL.
+pub const STOP_GRACE: Duration = Duration::from_secs(5);
+
+/// A deployment started by this process.
+#[derive(Debug)]
+pub struct RunningSuite {
+    /// What was started (also in `state.json`).
+    pub state: RunState,
+    children: Vec<Child>,
+}
+
+/// Command-line arguments of one instance.
+fn instance_args(plan: &Plan, instance: &PlannedInstance, config: &std::path::Path) -> Vec<String> {
+    vec![
+        "--config".into(),
+        config.display().to_string(),
+        "--prefix".into(),
+        plan.names.prefix().to_string(),
+        "--instance".into(),
+        instance.name.clone(),
+        "--heartbeat-ms".into(),
+        plan.heartbeat_ms.to_string(),
+    ]
+}
+
+/// Refuses to start over a live deployment of the same prefix; removes a
+/// stale state file.
+fn check_not_running(prefix: &str) -> Result<()> {
+    let Ok(old) = RunState::load(prefix) else {
+        return Ok(());
+    };
+    let alive: Vec<&str> = old
+        .instances
+        .iter()
+        .filter(|i| is_alive(i.pid, &i.binary))
+        .map(|i| i.name.as_str())
+        .collect();
+    if !alive.is_empty() {
+        bail!(
+            "deployment {prefix:?} is already running ({}): stop it with `spacepose down --prefix {prefix}`",
+            alive.join(", ")
+        );
+    }
+    let _ = std::fs::remove_file(RunState::path(prefix));
+    Ok(())
+}
+
+/// Starts every instance of `plan` and waits for their heartbeats on `watch`.
+/// Progress goes to `out`.
+pub fn start(plan: &Plan, watch: &mut HealthWatch, out: &mut dyn Write) -> Result<RunningSuite> {
+    let prefix = plan.names.prefix().to_string();
+    check_not_running(&prefix)?;
+    let dir = run_dir(&prefix);
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let mut suite = RunningSuite {
+        state: RunState {
+            prefix: prefix.clone(),
+            heartbeat_ms: plan.heartbeat_ms,
+            started_unix_s: unix_now_s(),
+            started_by_pid: std::process::id(),
+            instances: Vec::new(),
+        },
+        children: Vec::new(),
+    };
+    let (consumers, sources) = plan.start_order();
+    for stage in [consumers, sources] {
+        if let Err(e) = start_stage(plan, &stage, &mut suite, watch, out) {
+            let _ = suite.stop(out);
+            return Err(e);
+        }
+    }
+    suite.state.save()?;
+    Ok(suite)
+}
+
+fn start_stage(
+    plan: &Plan,
+    stage: &[&PlannedInstance],
+    suite: &mut RunningSuite,
+    watch: &mut HealthWatch,
+    out: &mut dyn Write,
+) -> Result<()> {
+    let dir = run_dir(plan.names.prefix());
+    let first = suite.children.len();
+    for instance in stage {
+        let config = dir.join(format!("{}.toml", instance.name));
+        std::fs::write(&config, toml::to_string(&instance.config)?)
+            .with_context(|| format!("cannot write {}", config.display()))?;
+        let log = dir.join(format!("{}.log", instance.name));
+        let _ = std::fs::remove_file(&log);
+        let child = spawn_logged(
+            &instance.binary,
+            &instance_args(plan, instance, &config),
+            &log,
+        )
+        .with_context(|| format!("service {:?}", instance.name))?;
+        writeln!(
+            out,
+            "started {:<12} {:<10} pid {}",
+            instance.name,
+            instance.kind,
+            child.id()
+        )?;
+        suite.state.instances.push(InstanceState {
+            name: instance.name.clone(),
+            kind: instance.kind,
+            pid: child.id(),
+            binary: instance.binary.clone(),
+            log,
+        });
+        suite.children.push(child);
+        // Keep a partial state file, so `down` can stop a half-started suite.
+        suite.state.save()?;
+    }
+    wait_healthy(suite, first, plan.health_timeout, watch)?;
+    for i in &suite.state.instances[first..] {
+        writeln!(out, "healthy {:<12} {:<10}", i.name, i.kind)?;
+    }
+    Ok(())
+}
+
+/// Waits until every instance from index `first` has sent a heartbeat from
+/// its own pid; fails as soon as one exits.
+fn wait_healthy(
+    suite: &mut RunningSuite,
+    first: usize,
+    timeout: Duration,
+    watch: &mut HealthWatch,
+) -> Result<()> {
+    let deadline = Instant::now() + timeout;
+    loop {
+        watch.poll(Duration::from_millis(100))?;
+        let mut waiting = Vec::new();
+        for (i, child) in suite.children.iter_mut().enumerate().skip(first) {
+            let inst = &suite.state.instances[i];
+            if let Ok(Some(status)) = child.try_wait() {
+                bail!(
+                    "service {:?} ({}) exited during start-up ({status}); last lines of {}:\n{}",
+                    inst.name,
+                    inst.kind,
+                    inst.log.display(),
+                    log_tail(&inst.log, 15)
+                );
+            }
+            if watch.get(&inst.name).is_none_or(|h| h.pid != inst.pid) {
+                waiting.push(i);
+            }
+        }
+        if waiting.is_empty() {
+            return Ok(());
+        }
+        if Instant::now() >= deadline {
+            let mut msg = String::new();
+            for i in waiting {
+                let inst = &suite.state.instances[i];
+                msg.push_str(&format!(
+                    "\nservice {:?} ({}) sent no heartbeat within {:.0} s; last lines of {}:\n{}",
+                    inst.name,
+                    inst.kind,
+                    timeout.as_secs_f64(),
+                    inst.log.display(),
+                    log_tail(&inst.log, 15)
+                ));
+            }
+            bail!("the suite did not become healthy:{msg}");
+        }
+    }
+}
+
+impl RunningSuite {
+    /// Process id of an instance.
+    pub fn pid(&self, instance: &str) -> Option<u32> {
+        self.state
+            .instances
+            .iter()
+            .find(|i| i.name == instance)
+            .map(|i| i.pid)
+    }
+
+    /// Instances whose process has exited (name, exit status).
+    pub fn exited(&mut self) -> Vec<(String, String)> {
+        let mut out = Vec::new();
+        for (child, inst) in self.children.iter_mut().zip(&self.state.instances) {
+            if let Ok(Some(status)) = child.try_wait() {
+                out.push((inst.name.clone(), status.to_string()));
+            }
+        }
+        out
+    }
+
+    /// The log file of an instance.
+    pub fn log(&self, instance: &str) -> Option<PathBuf> {
+        self.state
+            .instances
+            .iter()
+            .find(|i| i.name == instance)
+            .map(|i| i.log.clone())
+    }
+
+    /// Leaves the processes running (after `up`): they are reparented.
+    pub fn detach(self) -> RunState {
+        self.state
+    }
+
+    /// Stops every instance (SIGTERM, then SIGKILL after [`STOP_GRACE`]) and
+    /// removes the state file and the stale bus resources.
+    pub fn stop(mut self, out: &mut dyn Write) -> Result<()> {
+        let procs: Vec<(&str, u32, &std::path::Path)> = self
+            .state
+            .instances
+            .iter()
+            .map(|i| (i.name.as_str(), i.pid, i.binary.as_path()))
+            .collect();
+        let children = &mut self.children;
+        let killed = terminate(&procs, STOP_GRACE, || {
+            for c in children.iter_mut() {
+                let _ = c.try_wait();
+            }
+        });
+        for c in self.children.iter_mut() {
+            let _ = c.wait();
+        }
+        if !killed.is_empty() {
+            writeln!(
+                out,
+                "killed after {} s: {}",
+                STOP_GRACE.as_secs(),
+                killed.join(", ")
+            )?;
+        }
+        super::down::cleanup(&self.state.prefix, out)
+    }
+}

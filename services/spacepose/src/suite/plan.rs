@@ -1,0 +1,296 @@
+//! Validation of a descriptor into a [`Plan`]: everything is checked before
+//! anything starts, and every problem is reported at once.
+
+use super::binaries::BinarySearch;
+use super::config_check::check_config;
+use super::descriptor::{Descriptor, ZenohEndpoints};
+use super::kind::ServiceKind;
+use spacepose_messages::{Name, Names, Topic};
+use std::collections::{BTreeSet, HashMap};
+use std::path::PathBuf;
+use std::time::Duration;
+
+/// A validated deployment, ready to start.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// Deployment names (prefix).
+    pub names: Names,
+    /// Heartbeat period of every service (ms).
+    pub heartbeat_ms: u64,
+    /// How long to wait for every first heartbeat.
+    pub health_timeout: Duration,
+    /// zenoh endpoints of the suite.
+    pub zenoh: ZenohEndpoints,
+    /// The instances, in descriptor order.
+    pub instances: Vec<PlannedInstance>,
+}
+
+/// One instance to start.
+#[derive(Debug, Clone)]
+pub struct PlannedInstance {
+    /// Instance name.
+    pub name: String,
+    /// Service kind.
+    pub kind: ServiceKind,
+    /// Resolved binary.
+    pub binary: PathBuf,
+    /// Configuration (with the deployment's zenoh endpoints filled in).
+    pub config: toml::Table,
+}
+
+/// Every problem of a descriptor, one line each.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Problems(pub Vec<String>);
+
+impl std::fmt::Display for Problems {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the deployment descriptor has {} problem(s):",
+            self.0.len()
+        )?;
+        for p in &self.0 {
+            write!(f, "\n  - {p}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for Problems {}
+
+/// Whether `plan` runs each binary with `--check` on its configuration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ConfigCheck {
+    /// Run `binary --config FILE --check` for every instance.
+    Run,
+    /// Skip (unit tests without binaries).
+    Skip,
+}
+
+/// True when lidar-sim's config asks for the truth acquisition.
+pub fn truth_init(config: &toml::Table) -> bool {
+    config
+        .get("truth_init")
+        .and_then(toml::Value::as_bool)
+        .unwrap_or(false)
+}
+
+/// Fills in what the deployment decides for a service: the zenoh endpoints
+/// of telemetry (unless its config sets its own `zenoh` table).
+pub fn deployment_config(
+    kind: ServiceKind,
+    config: &toml::Table,
+    zenoh: &ZenohEndpoints,
+) -> toml::Table {
+    let mut config = config.clone();
+    if kind == ServiceKind::Telemetry && !config.contains_key("zenoh") {
+        let mut z = toml::Table::new();
+        let list =
+            |v: &[String]| toml::Value::Array(v.iter().cloned().map(toml::Value::String).collect());
+        z.insert("listen".into(), list(&zenoh.listen));
+        z.insert("connect".into(), list(&zenoh.connect));
+        config.insert("zenoh".into(), toml::Value::Table(z));
+    }
+    config
+}
+
+/// Validates `descriptor` into a plan, or lists every problem.
+pub fn plan(
+    descriptor: &Descriptor,
+    search: &BinarySearch,
+    check: ConfigCheck,
+) -> Result<Plan, Problems> {
+    let mut problems = Vec::new();
+    let names = Names::new(&descriptor.prefix)
+        .map_err(|e| problems.push(format!("prefix: {e}")))
+        .ok();
+    if descriptor.services.is_empty() {
+        problems.push("no [[service]] entries".to_string());
+    }
+    if !(descriptor.health_timeout_s.is_finite() && descriptor.health_timeout_s > 0.0) {
+        problems.push(format!(
+            "health_timeout_s must be a positive number of seconds, got {}",
+            descriptor.health_timeout_s
+        ));
+    }
+    if descriptor.heartbeat_ms == 0 {
+        problems.push("heartbeat_ms must be >= 1".to_string());
+    }
+    check_instance_names(descriptor, &mut problems);
+    check_topics(descriptor, &mut problems);
+    let mut instances = Vec::new();
+    for s in &descriptor.services {
+        let binary = match search.resolve(s.binary.as_deref(), &s.kind.binary_name()) {
+            Ok(b) => b,
+            Err(e) => {
+                problems.push(format!("service {:?} ({}): {e}", s.name, s.kind));
+                continue;
+            }
+        };
+        let config = deployment_config(s.kind, &s.config, &descriptor.zenoh);
+        if check == ConfigCheck::Run
+            && let Err(e) = check_config(&binary, &config)
+        {
+            problems.push(format!(
+                "service {:?} ({}): invalid config: {e}",
+                s.name, s.kind
+            ));
+        }
+        instances.push(PlannedInstance {
+            name: s.name.clone(),
+            kind: s.kind,
+            binary,
+            config,
+        });
+    }
+    match names {
+        Some(names) if problems.is_empty() => Ok(Plan {
+            names,
+            heartbeat_ms: descriptor.heartbeat_ms,
+            health_timeout: Duration::from_secs_f64(descriptor.health_timeout_s),
+            zenoh: descriptor.zenoh.clone(),
+            instances,
+        }),
+        _ => Err(Problems(problems)),
+    }
+}
+
+fn check_instance_names(descriptor: &Descriptor, problems: &mut Vec<String>) {
+    let mut seen = BTreeSet::new();
+    for s in &descriptor.services {
+        let file_safe = !s.name.is_empty()
+            && s.name
+                .bytes()
+                .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'-' || b == b'_');
+        if !file_safe || Name::new(&s.name).is_err() {
+            problems.push(format!(
+                "service name {:?}: use 1-24 characters of a-z, 0-9, '-' and '_'",
+                s.name
+            ));
+        }
+        if !seen.insert(s.name.as_str()) {
+            problems.push(format!("service name {:?} is used twice", s.name));
+        }
+    }
+}
+
+fn check_topics(descriptor: &Descriptor, problems: &mut Vec<String>) {
+    let mut producers: HashMap<Topic, Vec<&str>> = HashMap::new();
+    for s in &descriptor.services {
+        for t in s.kind.outputs(truth_init(&s.config)) {
+            producers.entry(t).or_default().push(&s.name);
+        }
+    }
+    for s in &descriptor.services {
+        for &t in s.kind.required_inputs() {
+            if producers
+                .get(&t)
+                .is_some_and(|p| p.iter().any(|n| *n != s.name))
+            {
+                continue;
+            }
+            let kinds: Vec<String> = ServiceKind::producers_of(t)
+                .iter()
+                .map(|k| {
+                    if *k == ServiceKind::LidarSim && t == Topic::Acquisition {
+                        "lidar-sim with truth_init = true".to_string()
+                    } else {
+                        k.to_string()
+                    }
+                })
+                .collect();
+            problems.push(format!(
+                "service {:?} ({}) reads topic {:?} but no service of the descriptor publishes it \
+                 (add one of: {})",
+                s.name,
+                s.kind,
+                t.as_str(),
+                kinds.join(", ")
+            ));
+        }
+    }
+}
+
+impl Plan {
+    /// The instances in start order: consumers first, sources last.
+    pub fn start_order(&self) -> (Vec<&PlannedInstance>, Vec<&PlannedInstance>) {
+        self.instances.iter().partition(|i| !i.kind.is_source())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn search() -> BinarySearch {
+        BinarySearch {
+            exe_dir: None,
+            path: vec![],
+            base_dir: PathBuf::from("/bin"),
+        }
+    }
+
+    fn descriptor(body: &str) -> Descriptor {
+        let mut text = String::from("prefix = \"t\"\n");
+        for line in body.lines() {
+            let (name, kind) = line.split_once(' ').unwrap();
+            text.push_str(&format!(
+                "[[service]]\nname = \"{name}\"\nkind = \"{kind}\"\nbinary = \"/bin/sh\"\n"
+            ));
+            if kind == "lidar-sim" {
+                text.push_str("config = { truth_init = true }\n");
+            }
+        }
+        Descriptor::parse(&text).unwrap()
+    }
+
+    #[test]
+    fn a_full_suite_plans_with_sources_last() {
+        let d = descriptor(
+            "sim lidar-sim\ningest ingest\ntracker tracker\nfilter filter\ntelemetry telemetry",
+        );
+        let p = plan(&d, &search(), ConfigCheck::Skip).unwrap();
+        let (first, last) = p.start_order();
+        assert_eq!(first.len(), 4);
+        assert_eq!(last[0].name, "sim");
+        let t = p
+            .instances
+            .iter()
+            .find(|i| i.kind == ServiceKind::Telemetry)
+            .unwrap();
+        assert_eq!(
+            t.config["zenoh"]["listen"][0].as_str(),
+            Some(super::super::descriptor::DEFAULT_LISTEN)
+        );
+    }
+
+    #[test]
+    fn topic_mismatches_are_named() {
+        let e = plan(
+            &descriptor("tracker tracker\nfilter filter"),
+            &search(),
+            ConfigCheck::Skip,
+        )
+        .unwrap_err();
+        let text = e.to_string();
+        assert!(
+            text.contains("\"cloud\"") && text.contains("add one of: ingest"),
+            "{text}"
+        );
+        assert!(text.contains("truth_init"), "{text}");
+        let e = plan(&descriptor("ingest ingest"), &search(), ConfigCheck::Skip).unwrap_err();
+        assert!(e.to_string().contains("raw_cloud"), "{e}");
+    }
+
+    #[test]
+    fn duplicate_and_bad_names_and_missing_binaries_are_reported_together() {
+        let mut d = descriptor("sim lidar-sim\nsim ingest\nBad_Name filter");
+        d.services[2].binary = Some(PathBuf::from("/nonexistent/spacepose-filter"));
+        let e = plan(&d, &search(), ConfigCheck::Skip).unwrap_err();
+        let text = e.to_string();
+        assert!(text.contains("used twice"), "{text}");
+        assert!(text.contains("\"Bad_Name\""), "{text}");
+        assert!(text.contains("/nonexistent/spacepose-filter"), "{text}");
+        assert!(text.contains("\"pose\""), "{text}");
+    }
+}

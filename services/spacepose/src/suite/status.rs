@@ -1,0 +1,91 @@
+//! `spacepose status`: a table of the instances of running deployments.
+
+use super::health::HealthWatch;
+use super::process::is_alive;
+use super::state::RunState;
+use crate::eval::table::Table;
+use anyhow::Result;
+use spacepose_bus::Bus;
+use spacepose_messages::{Health, Names, ServiceState, realtime_ns};
+use std::io::Write;
+use std::time::Duration;
+
+/// Prints the status of `prefix` (every running deployment when `None`).
+pub fn run(prefix: Option<&str>, out: &mut dyn Write) -> Result<()> {
+    let states = match prefix {
+        Some(p) => vec![RunState::load(p)?],
+        None => RunState::all(),
+    };
+    if states.is_empty() {
+        writeln!(out, "no running deployment")?;
+        return Ok(());
+    }
+    for state in states {
+        let names = Names::new(&state.prefix)?;
+        let bus = Bus::open(&names, &format!("spacepose-status-{}", std::process::id()))?;
+        let mut watch = HealthWatch::new(&bus, &names)?;
+        // Two heartbeat periods: every live instance reports at least once.
+        watch.collect_for(Duration::from_millis(2 * state.heartbeat_ms + 200))?;
+        let age_s = super::state::unix_now_s() - state.started_unix_s;
+        writeln!(
+            out,
+            "deployment {:?}, started {:.0} s ago",
+            state.prefix, age_s
+        )?;
+        write!(out, "{}", render(&state, &watch))?;
+    }
+    Ok(())
+}
+
+/// The status table of one deployment.
+pub fn render(state: &RunState, watch: &HealthWatch) -> String {
+    let mut t = Table::new(&[
+        "instance",
+        "kind",
+        "pid",
+        "alive",
+        "health",
+        "frames in",
+        "frames out",
+        "rejected",
+        "errors",
+        "last frame",
+        "heartbeat age s",
+    ]);
+    let now_ns = realtime_ns();
+    for i in &state.instances {
+        let alive = is_alive(i.pid, &i.binary);
+        let h = watch.get(&i.name).filter(|h| h.pid == i.pid);
+        let mut row = vec![
+            i.name.clone(),
+            i.kind.to_string(),
+            i.pid.to_string(),
+            if alive { "yes" } else { "no" }.to_string(),
+        ];
+        match h {
+            Some(h) => row.extend(health_cells(h, now_ns)),
+            None => row.extend(
+                ["no heartbeat".to_string()]
+                    .into_iter()
+                    .chain(std::iter::repeat_n("-".to_string(), 6)),
+            ),
+        }
+        t.row(row);
+    }
+    t.render()
+}
+
+fn health_cells(h: &Health, now_ns: i64) -> Vec<String> {
+    let state = ServiceState::from_u8(h.state).map_or("?", ServiceState::as_str);
+    let rejected =
+        h.rejected_non_finite + h.rejected_empty + h.rejected_oversized + h.rejected_wire;
+    vec![
+        state.to_string(),
+        h.frames_in.to_string(),
+        h.frames_out.to_string(),
+        rejected.to_string(),
+        h.errors.to_string(),
+        h.last_frame.to_string(),
+        format!("{:.2}", (now_ns - h.published_ns) as f64 * 1e-9),
+    ]
+}

@@ -1,0 +1,181 @@
+//! `spacepose demo` over the real binaries: a pose for every frame, errors
+//! within the tracking goals, and every pose received on the ground over
+//! zenoh by a separate `spacepose ground` process and by a Python
+//! `eclipse-zenoh` client (skipped, visibly, where it cannot be installed).
+#![allow(clippy::unwrap_used)] // test helpers
+
+use serde_json::Value;
+use spacepose_e2e::*;
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+const FRAMES: u64 = 20;
+const WARMUP: u64 = 10;
+
+/// Starts a listener process and waits for its first stdout line (it is
+/// subscribed by then).
+fn start_listener(cmd: &mut Command, what: &str) -> (Child, BufReader<std::process::ChildStdout>) {
+    let mut child = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap_or_else(|e| panic!("starting {what}: {e}"));
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    out.read_line(&mut line).unwrap();
+    assert!(!line.is_empty(), "{what} ended before subscribing");
+    (child, out)
+}
+
+fn finish(mut child: Child, mut out: BufReader<std::process::ChildStdout>, what: &str) -> String {
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while child.try_wait().unwrap().is_none() {
+        assert!(Instant::now() < deadline, "{what} did not finish");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut out, &mut rest).unwrap();
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+    let status = child.wait().unwrap();
+    assert!(status.success(), "{what} failed ({status}):\n{rest}\n{err}");
+    rest
+}
+
+#[test]
+fn demo_publishes_a_pose_for_every_frame_and_the_ground_receives_them() {
+    let spacepose_bin = require_suite();
+    let dir = scratch_dir("demo");
+    let prefix = unique_prefix("demo");
+    let _down = DownOnDrop(prefix.clone());
+    let suite_port = free_port();
+    let ground_port = free_port();
+    let record = dir.join("ground.jsonl");
+
+    // The ground tool listens; the suite's telemetry connects to it.
+    let ground_ep = format!("tcp/127.0.0.1:{ground_port}");
+    let (ground, ground_out) = start_listener(
+        Command::new(&spacepose_bin).args([
+            "ground",
+            "--listen",
+            &ground_ep,
+            "--prefix",
+            &prefix,
+            "--count",
+            &FRAMES.to_string(),
+            "--duration",
+            "150",
+            "--refresh-s",
+            "0",
+            "--record",
+            record.to_str().unwrap(),
+        ]),
+        "spacepose ground",
+    );
+
+    let python = match python_with_zenoh() {
+        Ok(py) => Some(py),
+        Err(why) => {
+            eprintln!("SKIPPED: the Python eclipse-zenoh client check ({why})");
+            None
+        }
+    };
+    let py_ep = format!("tcp/127.0.0.1:{}", free_port());
+    let py_listener = python.as_ref().map(|py| {
+        start_listener(
+            Command::new(py).args([
+                repo_root()
+                    .join("tests/python/listen_poses.py")
+                    .to_str()
+                    .unwrap(),
+                &py_ep,
+                &prefix,
+                &FRAMES.to_string(),
+                "150",
+            ]),
+            "the Python zenoh client",
+        )
+    });
+
+    let json = dir.join("demo.json");
+    let deploy = repo_root().join("deploy/demo.toml");
+    let mut args = vec![
+        "demo".to_string(),
+        "--deploy".into(),
+        deploy.display().to_string(),
+        "--frames".into(),
+        FRAMES.to_string(),
+        "--warmup".into(),
+        WARMUP.to_string(),
+        "--prefix".into(),
+        prefix.clone(),
+        "--listen".into(),
+        format!("tcp/127.0.0.1:{suite_port}"),
+        "--connect".into(),
+        ground_ep.clone(),
+        "--json".into(),
+        json.display().to_string(),
+    ];
+    if python.is_some() {
+        args.extend(["--connect".to_string(), py_ep.clone()]);
+    }
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let demo = spacepose(&args);
+    let demo_text = text(&demo);
+    assert!(demo.status.success(), "{demo_text}");
+    println!("{demo_text}");
+
+    // The demo's own scoring.
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(s["frames"], FRAMES, "{s}");
+    assert_eq!(s["poses_published"], FRAMES, "{demo_text}");
+    assert_eq!(s["missed_poses"], 0, "{demo_text}");
+    let conv_max = s["ang_err_deg_converged"]["max"].as_f64().unwrap();
+    assert!(
+        conv_max <= 3.0,
+        "max angular error after warm-up {conv_max}°\n{demo_text}"
+    );
+    let pos_mean = s["pos_err_cm"]["mean"].as_f64().unwrap();
+    assert!(
+        pos_mean <= 5.0,
+        "mean position error {pos_mean} cm\n{demo_text}"
+    );
+    for k in ["mean", "median", "max"] {
+        assert!(s["latency_ms"][k].as_f64().is_some_and(|v| v > 0.0), "{s}");
+    }
+    assert!(demo_text.contains("ang mean"), "{demo_text}");
+
+    // Nothing of the suite is left.
+    assert!(!state_file(&prefix).exists());
+    assert!(processes_mentioning(&format!("--prefix {prefix}")).is_empty());
+
+    // The ground tool received every pose.
+    finish(ground, ground_out, "spacepose ground");
+    let lines = std::fs::read_to_string(&record).unwrap();
+    let mut seqs: Vec<u64> = lines
+        .lines()
+        .map(|l| serde_json::from_str::<Value>(l).unwrap())
+        .filter(|v| v["key"].as_str().unwrap().ends_with("/telemetry/pose"))
+        .map(|v| v["payload"]["sequence"].as_u64().unwrap())
+        .collect();
+    seqs.sort_unstable();
+    seqs.dedup();
+    assert_eq!(seqs, (0..FRAMES).collect::<Vec<_>>(), "ground poses");
+
+    // And so did Python.
+    if let Some((child, out)) = py_listener {
+        let rest = finish(child, out, "the Python zenoh client");
+        let got: Value = serde_json::from_str(rest.trim()).unwrap();
+        let mut seqs: Vec<u64> = got["sequences"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_u64().unwrap())
+            .collect();
+        seqs.sort_unstable();
+        seqs.dedup();
+        assert_eq!(seqs, (0..FRAMES).collect::<Vec<_>>(), "python poses");
+        println!("python eclipse-zenoh client received {} poses", seqs.len());
+    }
+}
