@@ -5,8 +5,11 @@
 //! openers always agree on these values (iceoryx2 refuses to open a service
 //! whose limits are below what the opener asks for).
 
-/// Publishers per fixed-size message service.
-pub const MAX_PUBLISHERS: usize = 4;
+/// Publishers per fixed-size message service. Every service of a
+/// deployment publishes on the one health topic, and redundant instances
+/// publish poses side by side, so this is well above the number of
+/// processes a descriptor starts.
+pub const MAX_PUBLISHERS: usize = 16;
 /// Subscribers per fixed-size message service.
 pub const MAX_SUBSCRIBERS: usize = 16;
 /// Nodes per service.
