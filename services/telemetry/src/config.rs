@@ -1,0 +1,133 @@
+//! Configuration of the telemetry service (TOML).
+
+use crate::error::TelemetryError;
+use serde::{Deserialize, Serialize};
+
+/// How the telemetry process joins zenoh: peer mode, explicit endpoints,
+/// multicast scouting off (the bus's `ZenohConfig` is built from this).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ZenohEndpoints {
+    /// `"peer"` (default) or `"client"`.
+    pub mode: String,
+    /// Endpoints to listen on; ground tools connect here. Default
+    /// `tcp/127.0.0.1:7447` (loopback only).
+    pub listen: Vec<String>,
+    /// Endpoints to connect to (e.g. a router or the ground station).
+    pub connect: Vec<String>,
+}
+
+impl Default for ZenohEndpoints {
+    fn default() -> Self {
+        Self {
+            mode: "peer".into(),
+            listen: vec!["tcp/127.0.0.1:7447".into()],
+            connect: Vec::new(),
+        }
+    }
+}
+
+/// Largest publication rate per stream (Hz); 0 = every message.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Rates {
+    /// `pose` (default 0: every estimate reaches the ground).
+    pub pose_hz: f64,
+    /// `filter` (default 10 Hz).
+    pub filter_hz: f64,
+    /// `health/<instance>`, per instance (default 2 Hz).
+    pub health_hz: f64,
+    /// `truth` (default 0).
+    pub truth_hz: f64,
+    /// `errors` (default 0).
+    pub errors_hz: f64,
+}
+
+impl Default for Rates {
+    fn default() -> Self {
+        Self {
+            pose_hz: 0.0,
+            filter_hz: 10.0,
+            health_hz: 2.0,
+            truth_hz: 0.0,
+            errors_hz: 0.0,
+        }
+    }
+}
+
+/// The telemetry service's TOML file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TelemetryConfig {
+    /// zenoh endpoints.
+    pub zenoh: ZenohEndpoints,
+    /// Stream rate limits.
+    pub rates: Rates,
+    /// Frames kept to match estimates with truth by sequence.
+    pub match_window: usize,
+}
+
+impl Default for TelemetryConfig {
+    fn default() -> Self {
+        Self {
+            zenoh: ZenohEndpoints::default(),
+            rates: Rates::default(),
+            match_window: 64,
+        }
+    }
+}
+
+impl TelemetryConfig {
+    /// Checks every value (NaN fails).
+    pub fn validate(&self) -> Result<(), TelemetryError> {
+        let bad = |m: String| Err(TelemetryError::InvalidConfig(m));
+        let r = &self.rates;
+        for (name, hz) in [
+            ("rates.pose_hz", r.pose_hz),
+            ("rates.filter_hz", r.filter_hz),
+            ("rates.health_hz", r.health_hz),
+            ("rates.truth_hz", r.truth_hz),
+            ("rates.errors_hz", r.errors_hz),
+        ] {
+            if !(hz.is_finite() && hz >= 0.0) {
+                return bad(format!("{name} = {hz} must be finite and >= 0"));
+            }
+        }
+        if self.match_window == 0 {
+            return bad("match_window must be >= 1".into());
+        }
+        if self.zenoh.mode != "peer" && self.zenoh.mode != "client" {
+            return bad(format!(
+                "zenoh.mode = {:?} must be \"peer\" or \"client\"",
+                self.zenoh.mode
+            ));
+        }
+        if self.zenoh.listen.is_empty() && self.zenoh.connect.is_empty() {
+            return bad("zenoh needs at least one listen or connect endpoint".into());
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_loopback_and_strict() {
+        let c = TelemetryConfig::default();
+        c.validate().unwrap();
+        assert_eq!(c.zenoh.listen, ["tcp/127.0.0.1:7447"]);
+        let c: TelemetryConfig =
+            toml::from_str("[zenoh]\nlisten = [\"tcp/127.0.0.1:9000\"]\n[rates]\npose_hz = 5.0\n")
+                .unwrap();
+        assert_eq!((c.rates.pose_hz, c.rates.health_hz), (5.0, 2.0));
+        assert!(toml::from_str::<TelemetryConfig>("[rates]\nposes_hz = 1.0\n").is_err());
+        let mut c = TelemetryConfig::default();
+        c.rates.filter_hz = f64::NAN;
+        assert!(c.validate().unwrap_err().to_string().contains("filter_hz"));
+        let mut c = TelemetryConfig::default();
+        c.zenoh.listen.clear();
+        assert!(c.validate().is_err());
+    }
+}

@@ -1,0 +1,235 @@
+//! `spacepose-telemetry`: the suite seen from the ground.
+//!
+//! Subscribes to pose estimates, filter states, health and (simulated
+//! sources) truth on iceoryx2, and publishes them as JSON on zenoh under
+//! `spacepose/{prefix}/telemetry/`, with the errors against truth and a
+//! queryable `latest`. Logic: [`TelemetryHub`]; schema: `TELEMETRY.md`.
+
+use anyhow::Context;
+use clap::Parser;
+use serde::Deserialize;
+use spacepose_bus::zenoh::Wait;
+use spacepose_bus::zenoh::bytes::Encoding;
+use spacepose_bus::{Bus, Msg, Subscriber, WakeReason, ZenohConfig, open_zenoh, zenoh};
+use spacepose_messages::{FilterState, Health, Names, PoseEstimate, ServiceState, TruthMsg};
+use spacepose_service_kit::{
+    Counters, HealthReporter, ServiceArgs, ServiceConfig, init_logging, load_config, shutdown_flag,
+};
+use spacepose_telemetry::hub::Stream;
+use spacepose_telemetry::{
+    LATEST_KEY, Output, RateLimiter, TelemetryConfig, TelemetryError, TelemetryHub,
+};
+use std::collections::HashMap;
+use std::process::ExitCode;
+use std::sync::atomic::Ordering;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+const SERVICE: &str = "telemetry";
+
+/// The service configuration as a TOML file ([`TelemetryConfig`]).
+#[derive(Debug, Default, Deserialize)]
+#[serde(transparent)]
+struct Config(TelemetryConfig);
+
+impl ServiceConfig for Config {
+    fn validate(&self) -> Result<(), String> {
+        self.0.validate().map_err(|e| e.to_string())
+    }
+}
+
+fn main() -> ExitCode {
+    match run(ServiceArgs::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            tracing::error!("{e:#}");
+            eprintln!("spacepose-telemetry: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+struct Ports {
+    poses: Subscriber<PoseEstimate>,
+    states: Subscriber<FilterState>,
+    health: Subscriber<Health>,
+    truth: Subscriber<TruthMsg>,
+}
+
+/// zenoh side: one JSON publisher per key, declared on first use.
+struct Ground {
+    session: zenoh::Session,
+    names: Names,
+    publishers: HashMap<String, zenoh::pubsub::Publisher<'static>>,
+    limiter: RateLimiter,
+    rates: spacepose_telemetry::Rates,
+}
+
+impl Ground {
+    fn publish(&mut self, o: &Output, counters: &mut Counters) {
+        let hz = match o.stream {
+            Stream::Pose => self.rates.pose_hz,
+            Stream::Filter => self.rates.filter_hz,
+            Stream::Health => self.rates.health_hz,
+            Stream::Truth => self.rates.truth_hz,
+            Stream::Errors => self.rates.errors_hz,
+        };
+        if !self.limiter.allow(&o.key, hz, Instant::now()) {
+            return;
+        }
+        if !self.publishers.contains_key(&o.key) {
+            let key = self.names.telemetry_key(&o.key);
+            match self
+                .session
+                .declare_publisher(key.clone())
+                .encoding(Encoding::APPLICATION_JSON)
+                .wait()
+            {
+                Ok(p) => {
+                    self.publishers.insert(o.key.clone(), p);
+                }
+                Err(e) => {
+                    counters.errors += 1;
+                    tracing::warn!(key, "declaring a zenoh publisher: {e}");
+                    return;
+                }
+            }
+        }
+        if let Some(p) = self.publishers.get(&o.key) {
+            match p.put(o.json.clone()).wait() {
+                Ok(()) => counters.frames_out += 1,
+                Err(e) => {
+                    counters.errors += 1;
+                    tracing::warn!(key = o.key, "zenoh put: {e}");
+                }
+            }
+        }
+    }
+}
+
+fn zenoh_config(c: &TelemetryConfig) -> ZenohConfig {
+    ZenohConfig {
+        mode: c.zenoh.mode.clone(),
+        listen: c.zenoh.listen.clone(),
+        connect: c.zenoh.connect.clone(),
+        multicast_scouting: false,
+    }
+}
+
+fn run(args: ServiceArgs) -> anyhow::Result<()> {
+    init_logging(SERVICE);
+    let Config(config) = load_config(args.config.as_deref())?;
+    let names = Names::new(&args.prefix).context("deployment prefix")?;
+    let instance = args.instance_or(SERVICE);
+    let shutdown = shutdown_flag();
+    let session = open_zenoh(&zenoh_config(&config)).context("opening zenoh")?;
+    let mut hub = TelemetryHub::new(names.prefix(), config.match_window);
+    let latest = Arc::new(Mutex::new(hub.latest_json()?));
+    let _queryable = declare_latest(&session, &names, Arc::clone(&latest))?;
+
+    let bus = Bus::open(&names, &instance).context("opening the bus")?;
+    let ports = Ports {
+        poses: bus.subscriber(&names.pose())?,
+        states: bus.subscriber(&names.filter_state())?,
+        health: bus.subscriber(&names.health())?,
+        truth: bus.subscriber(&names.truth())?,
+    };
+    let heartbeat = Duration::from_millis(args.heartbeat_ms.max(1));
+    let mut health = HealthReporter::new(&bus, &names, SERVICE, &instance, heartbeat)?;
+    let mut waiter = bus.waitset()?;
+    for attach in [
+        waiter.attach(&ports.poses),
+        waiter.attach(&ports.states),
+        waiter.attach(&ports.health),
+        waiter.attach(&ports.truth),
+    ] {
+        attach?;
+    }
+    let mut ground = Ground {
+        session,
+        names: names.clone(),
+        publishers: HashMap::new(),
+        limiter: RateLimiter::new(),
+        rates: config.rates.clone(),
+    };
+    let mut counters = Counters::default();
+    tracing::info!(prefix = names.prefix(), instance, listen = ?config.zenoh.listen, "telemetry service running");
+    while !shutdown.load(Ordering::Relaxed) {
+        if waiter.wait(heartbeat)? == WakeReason::TerminationRequested {
+            break;
+        }
+        let mut go = |outs: Result<Vec<Output>, TelemetryError>, counters: &mut Counters| match outs
+        {
+            Ok(outs) => outs.iter().for_each(|o| ground.publish(o, counters)),
+            Err(e) => {
+                counters.rejected_wire += 1;
+                tracing::warn!("message refused: {e}");
+            }
+        };
+        drain(&ports.truth, &mut counters, |m, c| go(hub.on_truth(m), c));
+        drain(&ports.poses, &mut counters, |m, c| {
+            c.last_frame = m.sequence;
+            go(hub.on_pose(m), c);
+        });
+        drain(&ports.states, &mut counters, |m, c| go(hub.on_filter(m), c));
+        drain(&ports.health, &mut counters, |m, c| go(hub.on_health(m), c));
+        match (hub.latest_json(), latest.lock()) {
+            (Ok(json), Ok(mut slot)) => *slot = json,
+            _ => counters.errors += 1,
+        }
+        health.tick(&counters, ServiceState::Running as u8)?;
+    }
+    tracing::info!("telemetry service stopping");
+    health.send(&counters, ServiceState::Stopping as u8)?;
+    Ok(())
+}
+
+/// Drains `sub`, handing every message to `handle`; receive errors are counted.
+fn drain<T: Msg>(
+    sub: &Subscriber<T>,
+    counters: &mut Counters,
+    mut handle: impl FnMut(&T, &mut Counters),
+) {
+    loop {
+        match sub.try_recv() {
+            Ok(Some(m)) => {
+                counters.frames_in += 1;
+                handle(&m, counters);
+            }
+            Ok(None) => return,
+            Err(e) => {
+                counters.errors += 1;
+                tracing::warn!(service = sub.service(), "receiving: {e}");
+                return;
+            }
+        }
+    }
+}
+
+/// The queryable `spacepose/{prefix}/telemetry/latest`: replies with the
+/// latest state as one JSON object.
+fn declare_latest(
+    session: &zenoh::Session,
+    names: &Names,
+    latest: Arc<Mutex<String>>,
+) -> anyhow::Result<zenoh::query::Queryable<()>> {
+    let key = names.telemetry_key(LATEST_KEY);
+    let reply_key = key.clone();
+    session
+        .declare_queryable(key.clone())
+        .callback(move |query| {
+            let json = match latest.lock() {
+                Ok(json) => json.clone(),
+                Err(_) => return,
+            };
+            if let Err(e) = query
+                .reply(reply_key.clone(), json)
+                .encoding(Encoding::APPLICATION_JSON)
+                .wait()
+            {
+                tracing::warn!("replying to a latest query: {e}");
+            }
+        })
+        .wait()
+        .map_err(|e| anyhow::anyhow!("declaring the queryable {key}: {e}"))
+}
