@@ -27,6 +27,13 @@ pub struct LossConfig {
     pub max_innovation_rot_deg: f64,
     /// Largest position jump from the filter prediction (m).
     pub max_innovation_pos_m: f64,
+    /// A registration that stops at its iteration limit is only doubted
+    /// when its last increment is still above this angle (deg): reaching the
+    /// limit on a sparse frame is normal (seed 000 Table 2), still moving by
+    /// degrees is not.
+    pub max_final_increment_deg: f64,
+    /// See [`Self::max_final_increment_deg`] (m).
+    pub max_final_increment_m: f64,
     /// Degraded frames in a row after which the track is declared lost.
     pub max_consecutive_degraded: u32,
 }
@@ -40,7 +47,9 @@ impl Default for LossConfig {
             max_mean_cost_icp_m2: 0.002,
             max_innovation_rot_deg: 15.0,
             max_innovation_pos_m: 0.3,
-            max_consecutive_degraded: 3,
+            max_final_increment_deg: 1.0,
+            max_final_increment_m: 0.05,
+            max_consecutive_degraded: 5,
         }
     }
 }
@@ -116,6 +125,8 @@ impl TrackerConfig {
             ("loss.max_mean_cost_icp_m2", l.max_mean_cost_icp_m2),
             ("loss.max_innovation_rot_deg", l.max_innovation_rot_deg),
             ("loss.max_innovation_pos_m", l.max_innovation_pos_m),
+            ("loss.max_final_increment_deg", l.max_final_increment_deg),
+            ("loss.max_final_increment_m", l.max_final_increment_m),
         ];
         for (name, v) in positive {
             if !(v.is_finite() && v > 0.0) {

@@ -10,6 +10,8 @@
 use crate::config::TrackerConfig;
 use crate::error::TrackError;
 use crate::model::TrackingModel;
+use crate::output::TrackOutput;
+use crate::status::TrackStatus;
 use crate::tracker::Tracker;
 use crate::wire::{fill_estimate, lost_estimate, mode_from_wire};
 use spacepose_filter::wire::{acquisition_pose, prediction_from_state};
@@ -182,11 +184,14 @@ impl TrackerNode {
                 return result;
             }
         };
-        if let Err(e) = self.apply_pending(header) {
-            result.reason = format!("initialisation failed: {e}");
-            result.error = Some(e);
-            return result;
-        }
+        let refine_from = match self.apply_pending(header) {
+            Ok(pose) => pose,
+            Err(e) => {
+                result.reason = format!("initialisation failed: {e}");
+                result.error = Some(e);
+                return result;
+            }
+        };
         if !self.initialized {
             result.reason = "not initialised: awaiting an acquisition".into();
             return result;
@@ -197,6 +202,11 @@ impl TrackerNode {
         {
             Ok(out) => {
                 fill_estimate(&mut result.estimate, &out);
+                if let Some(given) = refine_from
+                    && let Err(e) = self.restart_after(&out, &given)
+                {
+                    result.error = Some(e);
+                }
                 result.reason = out.reason;
             }
             Err(e) => {
@@ -243,11 +253,14 @@ impl TrackerNode {
         None
     }
 
-    /// Starts a pending initialisation at `min(t, scan start)`, just before
-    /// the scan end, so that this very frame is tracked from it.
-    fn apply_pending(&mut self, header: &CloudHeader) -> Result<(), TrackError> {
+    /// Starts a pending initialisation at `min(t, scan start)` (just before
+    /// the scan end), so that this very frame is tracked from it. Returns the
+    /// pose when the initialisation time is after the scan start (the
+    /// acquisition's own frame, or a reinit command without time): the frame
+    /// is then only used to refine the pose, see [`Self::restart_after`].
+    fn apply_pending(&mut self, header: &CloudHeader) -> Result<Option<Pose>, TrackError> {
         let Some(p) = self.pending else {
-            return Ok(());
+            return Ok(None);
         };
         let (start, end) = (header.scan_start_s, header.scan_end_s);
         if !(start.is_finite() && end.is_finite() && start <= end) {
@@ -262,7 +275,25 @@ impl TrackerNode {
         self.tracker.initialize(t, &p.pose, zero, zero)?;
         self.pending = None;
         self.initialized = true;
-        Ok(())
+        let within_scan = p.t.is_none_or(|t_init| t_init > start);
+        Ok(within_scan.then_some(p.pose))
+    }
+
+    /// After the frame an initialisation pose belongs to: the filter must
+    /// not learn a rate from "pose of the scan end, placed at the scan
+    /// start" (it would learn ω ≈ 0 with confidence, and a tumbling
+    /// symmetric target then slides to a symmetric pose). The track restarts
+    /// at the scan end from the registered pose (or the given one if the
+    /// registration was not good), with zero rates and the initial
+    /// uncertainty, as the filter service does with the same estimate.
+    fn restart_after(&mut self, out: &TrackOutput, given: &Pose) -> Result<(), TrackError> {
+        let pose = if out.status == TrackStatus::Tracking {
+            &out.t_sensor_target
+        } else {
+            given
+        };
+        let zero = nalgebra::Vector3::zeros();
+        self.tracker.initialize(out.t, pose, zero, zero)
     }
 
     /// Puts the filter prediction at `t` into a lost estimate, when there is one.

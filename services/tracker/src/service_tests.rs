@@ -210,3 +210,37 @@ fn filter_states_are_followed_once_tracking() {
     bad.p_sensor_target[0] = f64::NAN;
     assert!(node.on_filter_state(&bad).is_err());
 }
+
+#[test]
+fn an_acquisition_at_its_own_scan_end_does_not_freeze_the_spin() {
+    // A truth acquisition as lidar-sim sends it: the pose at the scan end of
+    // frame 0. Placing it at the scan start and fusing frame 0 would teach
+    // the filter ω ≈ 0 with confidence, and the 10°/s tumble of the
+    // hexagonal body then slides to the 60° symmetric pose (seed 7, frames
+    // 8-14 above 55° before the restart after the refining frame).
+    let target = Arc::new(Target::builtin("deos").unwrap());
+    let mut config = ScenarioConfig::default_for(ScenarioKind::Tumbling);
+    config.seed = 7;
+    let scenario = build(&config).unwrap();
+    let mut sensor = SensorConfig::livox_mid40();
+    sensor.integration_time_s = 1.0;
+    let sim = LidarSimulator::new(target, sensor).unwrap();
+    let instance = Name::new("tracker-t").unwrap();
+    let config = TrackerConfig::with_mode(TrackingMode::Deblur);
+    let mut node = TrackerNode::new(config, fixture().model.clone(), instance, 200_000).unwrap();
+    let mut errors_deg = Vec::new();
+    for (k, &t) in scenario.frame_end_times(14).iter().enumerate() {
+        let f = sim.simulate(
+            &scenario.state_at(t),
+            &mut LidarSimulator::frame_rng(7, k as u64),
+        );
+        if k == 0 {
+            node.on_acquisition(&truth_acquisition(&f)).unwrap();
+        }
+        let r = node.on_cloud(&header(k as u64, &f), &f.points);
+        assert_ne!(status(&r), WireStatus::Lost, "frame {k}: {}", r.reason);
+        errors_deg.push(errors(&r, &f).0);
+    }
+    let last = &errors_deg[10..];
+    assert!(last.iter().all(|&e| e < 3.0), "{errors_deg:.1?}");
+}

@@ -315,11 +315,15 @@ impl Tracker {
                 r.cost.mean
             ));
         }
-        let stalled = r.last_increment.rotation_rad.to_degrees()
-            > 10.0 * self.config.ndt.termination_rotation_deg
-            || r.last_increment.translation_m > 10.0 * self.config.ndt.termination_translation_m;
+        let stalled = r.last_increment.rotation_rad.to_degrees() > l.max_final_increment_deg
+            || r.last_increment.translation_m > l.max_final_increment_m;
         if !r.converged && stalled {
-            reasons.push(format!("no convergence after {} iterations", r.iterations));
+            reasons.push(format!(
+                "no convergence after {} iterations (last step {:.2} deg, {:.3} m)",
+                r.iterations,
+                r.last_increment.rotation_rad.to_degrees(),
+                r.last_increment.translation_m
+            ));
         }
         reasons
     }
