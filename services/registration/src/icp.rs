@@ -1,5 +1,7 @@
 //! Point-to-point ICP (Besl & McKay; seed 000 §2.1, Table 1 ICP row) against
-//! a kd-tree over the model cloud built once ([`IcpModel`]).
+//! the model cloud, with its nearest-point structures built once
+//! ([`IcpModel`]): an exact voxel lookup grid within the correspondence
+//! distance, and a kiddo kd-tree beyond it.
 //!
 //! Each iteration pairs every transformed point with its nearest model
 //! point within `max_distance_m` and applies the closed-form optimal rigid
@@ -10,40 +12,112 @@
 use crate::error::RegistrationError;
 use crate::kdtree::{Tree3, build_tree};
 use crate::normal_equations::NormalEquations;
-use crate::params::IcpParams;
+use crate::params::check_positive;
+use crate::params::{CellLookup, IcpParams};
 use crate::result::{Cost, Increment, Registration};
 use crate::source::{check_pose, finite_positions};
 use kiddo::SquaredEuclidean;
 use nalgebra::{Matrix3, Rotation3, Vector3, Vector6};
+use point_grid::PointGrid;
 use spacepose_geometry::{Point, Pose, so3};
 
-/// The model cloud and its kd-tree, built once per target.
+mod point_grid;
+
+/// Distance the default lookup grid of [`IcpModel::new`] is exact for (m):
+/// Table 1's ICP correspondence distance.
+pub const DEFAULT_GRID_MAX_DISTANCE_M: f64 = 0.10;
+/// Voxel edge of the default lookup grid (m).
+pub const DEFAULT_GRID_RESOLUTION_M: f64 = 0.03;
+/// Upper bound on the number of lookup-grid voxels (memory guard); the
+/// voxel edge is coarsened until the grid fits.
+pub const MAX_GRID_VOXELS: usize = 1 << 23;
+
+/// Figures describing the lookup grid of an [`IcpModel`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IcpLookupStats {
+    /// Voxel edge actually used (m).
+    pub resolution_m: f64,
+    /// Grid dimensions.
+    pub dims: [u32; 3],
+    /// Distance the grid is exact for (m).
+    pub max_distance_m: f64,
+    /// Candidate entries over all voxels.
+    pub candidates: usize,
+    /// Voxels with at least one candidate.
+    pub non_empty_voxels: usize,
+}
+
+/// The model cloud with its kd-tree and its exact nearest-point lookup
+/// grid, built once per target.
 #[derive(Debug)]
 pub struct IcpModel {
     points: Vec<Vector3<f64>>,
     tree: Tree3,
+    grid: PointGrid,
 }
 
 impl IcpModel {
-    /// Builds the kd-tree over `model` (target body frame, m).
+    /// Builds the kd-tree and the default lookup grid (exact within
+    /// [`DEFAULT_GRID_MAX_DISTANCE_M`]) over `model` (target body frame, m).
+    /// The points are kept rounded to f32 (a shift below 0.2 µm within
+    /// 2 m of the origin), for the compact grid; both lookups see the same
+    /// rounded points.
     ///
     /// Errors: fewer than 3 points, or a non-finite point.
     pub fn new(model: &[Vector3<f64>]) -> Result<Self, RegistrationError> {
+        Self::with_grid(
+            model,
+            DEFAULT_GRID_MAX_DISTANCE_M,
+            DEFAULT_GRID_RESOLUTION_M,
+        )
+    }
+
+    /// [`IcpModel::new`] with a lookup grid exact within
+    /// `grid_max_distance_m`, of voxel edge `grid_resolution_m`. Queries
+    /// with a larger correspondence distance use the kd-tree.
+    ///
+    /// Errors: those of [`IcpModel::new`], and a non-finite or
+    /// non-positive distance or edge.
+    pub fn with_grid(
+        model: &[Vector3<f64>],
+        grid_max_distance_m: f64,
+        grid_resolution_m: f64,
+    ) -> Result<Self, RegistrationError> {
+        check_positive("grid_max_distance_m", grid_max_distance_m)?;
+        check_positive("grid_resolution_m", grid_resolution_m)?;
         if model.len() < 3 {
             return Err(RegistrationError::InvalidModel(format!(
                 "{} points, at least 3 needed",
                 model.len()
             )));
         }
-        if let Some(i) = model.iter().position(|p| !p.iter().all(|v| v.is_finite())) {
+        if model.len() > u32::MAX as usize {
             return Err(RegistrationError::InvalidModel(format!(
-                "point {i} is not finite"
+                "{} points, at most {} supported",
+                model.len(),
+                u32::MAX
             )));
         }
-        Ok(Self {
-            points: model.to_vec(),
-            tree: build_tree(model)?,
-        })
+        // f32-exact points (lidar clouds are f32 anyway): the grid stores
+        // its candidates in f32, and kd-tree and grid see the same points.
+        let points: Vec<Vector3<f64>> = model
+            .iter()
+            .map(|p| p.map(|v| f64::from(v as f32)))
+            .collect();
+        if let Some(i) = points.iter().position(|p| !p.iter().all(|v| v.is_finite())) {
+            return Err(RegistrationError::InvalidModel(format!(
+                "point {i} is not finite (in f32)"
+            )));
+        }
+        let tree = build_tree(&points)?;
+        let grid = PointGrid::build(
+            &points,
+            &tree,
+            grid_max_distance_m,
+            grid_resolution_m,
+            MAX_GRID_VOXELS,
+        );
+        Ok(Self { points, tree, grid })
     }
 
     /// Number of model points.
@@ -56,15 +130,61 @@ impl IcpModel {
         self.points.is_empty()
     }
 
-    /// The nearest model point to `q` and the squared distance.
+    /// Figures describing the lookup grid.
+    pub fn lookup_stats(&self) -> IcpLookupStats {
+        let (resolution_m, dims, candidates, non_empty_voxels) = self.grid.stats();
+        IcpLookupStats {
+            resolution_m,
+            dims,
+            max_distance_m: self.grid.max_distance,
+            candidates,
+            non_empty_voxels,
+        }
+    }
+
+    /// The nearest model point to `q` and the squared distance (kd-tree).
     #[inline]
-    fn nearest(&self, q: &Vector3<f64>) -> (&Vector3<f64>, f64) {
+    fn nearest(&self, q: &Vector3<f64>) -> (Vector3<f64>, f64) {
         let hit = self
             .tree
             .query(&[q.x, q.y, q.z])
             .nearest_one::<SquaredEuclidean<f64>>()
             .execute();
-        (&self.points[hit.item as usize], hit.distance)
+        (self.points[hit.item as usize], hit.distance)
+    }
+
+    /// The nearest model point to `q` and the squared distance, if within
+    /// `max_distance_m`. [`CellLookup::Grid`] uses the grid when
+    /// `max_distance_m` does not exceed the distance it was built for;
+    /// otherwise, and for [`CellLookup::KdTree`], the kd-tree answers. Both
+    /// are exact.
+    #[inline]
+    fn nearest_within(
+        &self,
+        q: &Vector3<f64>,
+        max_distance_m: f64,
+        lookup: CellLookup,
+    ) -> Option<(Vector3<f64>, f64)> {
+        let max2 = max_distance_m * max_distance_m;
+        if lookup == CellLookup::Grid && max_distance_m <= self.grid.max_distance {
+            return self.grid.nearest_within(q, max2);
+        }
+        let (m, d2) = self.nearest(q);
+        (d2 <= max2).then_some((m, d2))
+    }
+
+    /// The nearest model point to `q` and the squared distance, with no
+    /// distance limit: the grid when it has a point within its distance,
+    /// the kd-tree otherwise (or always, for [`CellLookup::KdTree`]).
+    #[inline]
+    fn nearest_any(&self, q: &Vector3<f64>, lookup: CellLookup) -> (Vector3<f64>, f64) {
+        if lookup == CellLookup::Grid {
+            let max = self.grid.max_distance;
+            if let Some(hit) = self.grid.nearest_within(q, max * max) {
+                return hit;
+            }
+        }
+        self.nearest(q)
     }
 }
 
@@ -102,6 +222,20 @@ fn kabsch(pairs: &Pairs) -> Option<(Rotation3<f64>, Vector3<f64>)> {
     Some((r, m_bar - r * x_bar))
 }
 
+/// Reorders `points` by the 10 cm cell they fall in at pose `t` (ties in
+/// their original order), so that successive lookups touch neighbouring
+/// parts of the grid (cache locality; the sums only change by rounding).
+fn spatial_order(points: &mut [Vector3<f64>], t: &Pose) {
+    const CELL_M: f64 = 0.1;
+    let key = |z: &Vector3<f64>| {
+        let x = t.transform(z) / CELL_M;
+        // 21 bits per axis around the origin; the order only matters for speed.
+        let b = |v: f64| ((v.floor() as i64).clamp(-(1 << 20), (1 << 20) - 1) + (1 << 20)) as u64;
+        (b(x.z) << 42) | (b(x.y) << 21) | b(x.x)
+    };
+    points.sort_by_cached_key(key);
+}
+
 /// Registers `source` (sensor frame) against `model` (target body frame)
 /// by point-to-point ICP from `initial_t_target_sensor`.
 ///
@@ -121,7 +255,8 @@ pub fn register_icp(
 ) -> Result<Registration, RegistrationError> {
     params.validate()?;
     check_pose("initial_t_target_sensor", initial_t_target_sensor)?;
-    let (points, skipped) = finite_positions(source)?;
+    let (mut points, skipped) = finite_positions(source)?;
+    spatial_order(&mut points, initial_t_target_sensor);
     let max2 = params.max_distance_m * params.max_distance_m;
     let no_match = |iteration| RegistrationError::NoCorrespondences {
         iteration,
@@ -136,10 +271,10 @@ pub fn register_icp(
             cross: Matrix3::zeros(),
             count: 0,
         };
+        let rotation = pose.rotation.matrix();
         for z in &points {
-            let x = pose.transform(z);
-            let (m, d2) = model.nearest(&x);
-            if d2 <= max2 {
+            let x = rotation * z + pose.translation;
+            if let Some((m, _)) = model.nearest_within(&x, params.max_distance_m, params.lookup) {
                 pairs.x_sum += x;
                 pairs.m_sum += m;
                 pairs.cross += m * x.transpose();
@@ -175,7 +310,7 @@ pub fn register_icp(
     for z in &points {
         let rz = pose.rotation * z;
         let x = rz + pose.translation;
-        let (m, d2) = model.nearest(&x);
+        let (m, d2) = model.nearest_any(&x, params.lookup);
         all_d2 += d2;
         if d2 <= max2 {
             ne.add_rigid(&rz, &identity, &(x - m));

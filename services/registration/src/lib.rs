@@ -31,7 +31,7 @@ mod test_support;
 
 pub use ct_ndt::{ScanTimes, ct_point_jacobian, interpolate, register_ct_ndt};
 pub use error::RegistrationError;
-pub use icp::{IcpModel, register_icp};
+pub use icp::{IcpLookupStats, IcpModel, register_icp};
 pub use ndt::register_ndt;
 pub use ndt_map::{NdtCell, NdtMap, NdtMapStats};
 pub use params::{CellLookup, IcpParams, NdtMapParams, NdtParams};

@@ -94,7 +94,8 @@ impl NdtMapParams {
     }
 }
 
-/// How to find the cell η(i) associated with a transformed point.
+/// How to find the cell η(i) associated with a transformed point (NDT),
+/// or the nearest model point (ICP, [`IcpParams::lookup`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum CellLookup {
     /// The map's precomputed voxel grid of candidate cells (exact nearest
@@ -175,6 +176,12 @@ pub struct IcpParams {
     /// Standard deviation of the point-to-point residual along each axis
     /// (m), used to scale the information matrix `Σ JᵀJ / σ²`.
     pub point_sigma_m: f64,
+    /// Nearest-model-point search: [`CellLookup::Grid`] is the model's
+    /// precomputed voxel grid of candidate points (exact within the
+    /// distance it was built for, kd-tree beyond), [`CellLookup::KdTree`]
+    /// the kiddo kd-tree alone. Both give the same pairs.
+    #[serde(default)]
+    pub lookup: CellLookup,
 }
 
 impl Default for IcpParams {
@@ -184,6 +191,7 @@ impl Default for IcpParams {
             max_iterations: 40,
             termination_increment: 1e-6,
             point_sigma_m: 0.01,
+            lookup: CellLookup::Grid,
         }
     }
 }

@@ -1,5 +1,6 @@
 use super::*;
 use crate::test_support::{frame, perturb, rng, target, true_t_sensor_target};
+use rand::RngExt;
 use std::sync::OnceLock;
 
 fn model() -> &'static IcpModel {
@@ -109,4 +110,63 @@ fn bad_input_is_an_error_value() {
         register_icp(model(), &frame()[..2], &truth, &p),
         Err(RegistrationError::DegenerateSystem { .. })
     ));
+}
+
+/// The grid answers exactly what the kd-tree answers, for queries spread
+/// up to 13 cm around the model (beyond the 10 cm the grid serves) and for
+/// the frame at offset poses, at two voxel sizes.
+#[test]
+fn grid_lookup_is_exact_against_the_kd_tree() {
+    let points = target().model();
+    let mut rng = rng(31);
+    let mut queries: Vec<Vector3<f64>> = (0..40_000)
+        .map(|_| {
+            let base = points[rng.random_range(0..points.len())];
+            let dir = Vector3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            );
+            base + dir * rng.random_range(0.0..0.13)
+        })
+        .collect();
+    let truth = true_t_sensor_target().inverse();
+    for k in 0..4 {
+        let t = perturb(
+            &truth,
+            f64::to_radians(2.0 * k as f64),
+            0.02 * k as f64,
+            &mut rng,
+        );
+        queries.extend(frame().iter().map(|p| t.transform(&p.position())));
+    }
+    for resolution in [0.03, 0.047] {
+        let m = IcpModel::with_grid(&points, 0.10, resolution).unwrap();
+        let stats = m.lookup_stats();
+        println!("{stats:?}");
+        assert!(stats.non_empty_voxels > 0);
+        let (mut within, mut beyond) = (0, 0);
+        for max_distance in [0.10, 0.05] {
+            let max2: f64 = max_distance * max_distance;
+            for q in &queries {
+                let (kd_point, kd_d2) = m.nearest(q);
+                match m.nearest_within(q, max_distance, CellLookup::Grid) {
+                    Some((p, d2)) => {
+                        assert!(kd_d2 <= max2, "{q:?}: grid {d2}, kd-tree {kd_d2}");
+                        assert!((d2 - kd_d2).abs() <= 1e-15, "{q:?}: {d2} vs {kd_d2}");
+                        assert!(((p - q).norm_squared() - d2).abs() <= 1e-15);
+                        within += 1;
+                    }
+                    None => {
+                        assert!(kd_d2 > max2, "{q:?}: kd-tree {kd_d2} at {kd_point:?}");
+                        beyond += 1;
+                    }
+                }
+                let (_, any_d2) = m.nearest_any(q, CellLookup::Grid);
+                assert!((any_d2 - kd_d2).abs() <= 1e-15);
+            }
+        }
+        println!("resolution {resolution}: {within} within, {beyond} beyond");
+        assert!(within > 0 && beyond > 0);
+    }
 }
