@@ -63,6 +63,8 @@ impl GroundState {
             self.malformed += 1;
             return Value::Null;
         };
+        // `health/<instance>`: counted and shown as `health`.
+        let what = what.split('/').next().unwrap_or(what);
         *self.received.entry(what.to_string()).or_insert(0) += 1;
         let Ok(value) = serde_json::from_slice::<Value>(payload) else {
             self.malformed += 1;
@@ -313,6 +315,8 @@ mod tests {
         assert_eq!(s.malformed, 2);
         s.on_message("spacepose/p/telemetry/filter", b"{}");
         assert_eq!(s.received["filter"], 1);
+        s.on_message("spacepose/p/telemetry/health/ingest", b"{}");
+        assert_eq!(s.received["health"], 1);
         assert!(s.render(Duration::from_secs(1)).contains("pose 2"));
     }
 }

@@ -95,8 +95,8 @@ impl ServiceKind {
             ServiceKind::Ingest => vec![Topic::Cloud],
             ServiceKind::Tracker => vec![Topic::Pose],
             ServiceKind::Filter => vec![Topic::FilterState],
-            // Commands from the ground come in through telemetry's bridge.
-            ServiceKind::Telemetry => vec![Topic::Command],
+            // JSON on zenoh only (no inbound command route yet).
+            ServiceKind::Telemetry => vec![],
         };
         if self == ServiceKind::LidarSim && truth_init {
             out.push(Topic::Acquisition);
