@@ -5,7 +5,7 @@ use crate::{FilterConfig, RelativeMotionFilter};
 use nalgebra::{Rotation3, Unit};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use spacepose_geometry::Pose;
+use spacepose_geometry::{Pose, so3};
 
 struct Scene {
     body: Vec<Vector3<f64>>,
@@ -171,4 +171,35 @@ fn non_finite_input_is_an_error() {
         .is_err()
     );
     assert_eq!(mc.compensate(&[]).unwrap(), vec![]);
+}
+
+/// The one-`sin_cos` fixed-axis rotation equals Eq. (12) written with a
+/// full `so3::exp`, for rates from zero to fast tumbles and both signs of
+/// `Δt`.
+#[test]
+fn fixed_axis_rotation_matches_the_full_exponential() {
+    let mut rng = ChaCha8Rng::seed_from_u64(41);
+    let unit = |rng: &mut ChaCha8Rng| {
+        Vector3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        )
+    };
+    for rate in [0.0, 1e-9, 0.02, 0.17, 1.0, 5.0] {
+        let w = unit(&mut rng).normalize() * rate;
+        let mc = MotionCompensation::new(10.0, unit(&mut rng) * 10.0, unit(&mut rng), w).unwrap();
+        for _ in 0..200 {
+            let z = unit(&mut rng) * 12.0;
+            let t = 10.0 + rng.random_range(-1.5..0.5);
+            let dt = mc.t_end - t;
+            let reference =
+                mc.p_sensor + so3::exp(&(mc.w_sensor * dt)) * (z - mc.p_sensor + mc.v_sensor * dt);
+            let fast = mc.position_at_end(&z, t);
+            assert!(
+                (fast - reference).norm() < 1e-12,
+                "{rate}: {fast} vs {reference}"
+            );
+        }
+    }
 }

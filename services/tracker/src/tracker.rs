@@ -181,10 +181,11 @@ impl Tracker {
         prediction: &Prediction,
     ) -> Result<Vec<Point>, TrackError> {
         if self.config.mode == TrackingMode::Deblur {
-            let finite: Vec<Point> = points.iter().copied().filter(Point::is_finite).collect();
-            let compensated =
-                MotionCompensation::from_prediction(prediction)?.compensate(&finite)?;
-            return Ok(self.voxel.filter(&compensated)?.points);
+            // One copy of the finite points, compensated in place (Eq. 12,
+            // one sin_cos per point about the fixed axis R ω).
+            let mut finite: Vec<Point> = points.iter().copied().filter(Point::is_finite).collect();
+            MotionCompensation::from_prediction(prediction)?.compensate_in_place(&mut finite)?;
+            return Ok(self.voxel.filter(&finite)?.points);
         }
         Ok(self.voxel.filter(points)?.points)
     }
