@@ -69,6 +69,7 @@ fn run_check(binary: &Path, file: &Path) -> Result<(), String> {
         .lines()
         .filter(|l| !l.trim().is_empty())
         .map(strip_ansi)
+        .map(|l| strip_log_prefix(&l).to_string())
         .collect::<Vec<_>>()
         .join(" / ");
     Err(if message.is_empty() {
@@ -76,6 +77,14 @@ fn run_check(binary: &Path, file: &Path) -> Result<(), String> {
     } else {
         message
     })
+}
+
+/// The message of a `tracing` line (`<time>  ERROR <target>: <message>`).
+fn strip_log_prefix(line: &str) -> &str {
+    match line.split_once(" ERROR ") {
+        Some((_, rest)) => rest.split_once(": ").map_or(rest, |(_, m)| m),
+        None => line,
+    }
 }
 
 /// Removes ANSI colour sequences from a log line.
@@ -129,5 +138,9 @@ mod tests {
     #[test]
     fn ansi_codes_are_stripped() {
         assert_eq!(strip_ansi("\u{1b}[31mERROR\u{1b}[0m x"), "ERROR x");
+        assert_eq!(
+            strip_log_prefix("2026-01-01T00:00:00Z ERROR spacepose_ingest: invalid config: x"),
+            "invalid config: x"
+        );
     }
 }

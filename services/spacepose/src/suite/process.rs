@@ -137,6 +137,9 @@ mod tests {
         let mut child = spawn_logged(sleep, &["30".to_string()], &log).unwrap();
         let pid = child.id();
         assert!(is_alive(pid, sleep));
+        // Let the exec finish (its command line is briefly empty).
+        std::thread::sleep(Duration::from_millis(100));
+        assert!(is_alive(pid, sleep));
         assert!(!is_alive(pid, Path::new("/bin/other")));
         let killed = terminate(&[("s", pid, sleep)], Duration::from_secs(5), || {
             let _ = child.try_wait();
