@@ -116,10 +116,10 @@ impl SensorConfig {
     /// Default integration time of the Mid-40 model (s), chosen so that a
     /// `deos` target at 10 m on the boresight returns about 10,000 points
     /// with the default effects (seed 004 §IV.C: adaptive integration time
-    /// for ~10,000 target points). Measured over 16 random attitudes: mean
-    /// 10,215 points (1,467 when a specular MLI end face is seen obliquely,
-    /// up to 15,361); 15,235 on average with no effect at all (72,000 rays).
-    pub const MID40_INTEGRATION_TIME_S: f64 = 0.72;
+    /// for ~10,000 target points). Measured over 16 random attitudes with
+    /// the Mid-40 receiver: mean 10,043 points with the default effects,
+    /// 11,424 with no effect at all (54,000 rays).
+    pub const MID40_INTEGRATION_TIME_S: f64 = 0.54;
 
     /// Livox Mid-40: rosette over a 38.4° circle at 100,000 points/s,
     /// σ_RANGE = 2 cm (seed 004 §IV.A), β = 0.28°, five divergent rays.
@@ -131,8 +131,9 @@ impl SensorConfig {
     /// - P_O = 5 %: the lower end of seed 002's 5-7 %, because beam
     ///   divergence and reflections already produce explicit artefacts here.
     /// - Maximum range 260 m (datasheet, at 80 % reflectivity).
-    /// - Detection: seed 002 Table 1 (a space-grade receiver; the Mid-40's
-    ///   own receiver is not documented).
+    /// - Detection: seed 002's detector chain (Table 1) scaled to the
+    ///   Mid-40 datasheet range, 90 m at 10 % reflectance
+    ///   ([`DetectionParams::livox_mid40`]).
     pub fn livox_mid40() -> Self {
         SensorConfig {
             pattern: ScanPattern::livox_mid40(),
@@ -146,7 +147,7 @@ impl SensorConfig {
             beam_divergence_deg: 0.28,
             divergent_rays: 5,
             max_range_m: 260.0,
-            detection: DetectionParams::seed002(),
+            detection: DetectionParams::livox_mid40(),
             facility: Facility::default(),
         }
     }

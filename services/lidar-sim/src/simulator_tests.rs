@@ -134,7 +134,8 @@ fn without_effects_every_point_lies_on_the_mesh() {
     let frame = run(&sim(Effects::none()), &truth, 2);
     let n = frame.points.len();
     println!("deos at 10 m, no effect: {n} points");
-    assert!((12_000..=20_000).contains(&n), "{n} points");
+    // 54,000 rays in the default 0.54 s scan; about a fifth hit the target.
+    assert!((9_000..=15_000).contains(&n), "{n} points");
     let inv = truth.t_sensor_target.inverse();
     for p in &frame.points {
         // Cast the true ray again at the end pose: the range must match.

@@ -257,6 +257,10 @@ pub struct EvalTrackingArgs {
     /// Scale applied to a mesh file's coordinates.
     #[arg(long, default_value_t = 1.0)]
     pub scale: f64,
+    /// First frame of the scenario to run (the trackers start on the truth
+    /// at that frame's scan start).
+    #[arg(long, default_value_t = 0)]
+    pub first_frame: usize,
     /// Frames excluded from the "converged" statistics while the filter
     /// learns the angular velocity (seed 000 §5.2).
     #[arg(long, default_value_t = 10)]

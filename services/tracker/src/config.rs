@@ -8,10 +8,14 @@ use spacepose_registration::{IcpParams, NdtParams};
 
 /// When a frame counts as degraded, and when the track counts as lost.
 ///
-/// The thresholds were set from simulated `deos` frames (seed 1 only, never
-/// an evaluation seed): well-aligned frames have inlier fractions above 0.6
-/// and a mean NDT cost below 3; a 60° symmetric flip of the hexagonal body
-/// (seed 000 §5.2) shows up as a jump far above the innovation limits.
+/// The thresholds were set from simulated `deos` frames of the slow-spin
+/// scenario with seed 1 only (never an evaluation seed): well-aligned frames
+/// have inlier fractions above 0.55 and a mean NDT cost per inlier of 4.5 at
+/// the median and up to about 7 (it saturates, since associations stop at
+/// the maximum distance, so it is a weak signal); failed registrations show
+/// a collapsed inlier fraction, a cost above 10, or a jump away from the
+/// prediction; a 60° symmetric flip of the hexagonal body (seed 000 §5.2)
+/// is far above the innovation limits.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct LossConfig {
@@ -43,7 +47,7 @@ impl Default for LossConfig {
         Self {
             min_inliers: 100,
             min_inlier_fraction: 0.3,
-            max_mean_cost_ndt: 6.0,
+            max_mean_cost_ndt: 10.0,
             max_mean_cost_icp_m2: 0.002,
             max_innovation_rot_deg: 15.0,
             max_innovation_pos_m: 0.3,

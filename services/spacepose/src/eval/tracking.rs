@@ -84,10 +84,16 @@ pub struct FrameRecord {
     pub time_ms: f64,
     /// Registration iterations.
     pub iterations: usize,
+    /// Mean registration cost per inlier (NDT: Mahalanobis; ICP: m²).
+    pub cost_mean: f64,
+    /// Fraction of the used points with a correspondence.
+    pub inlier_fraction: f64,
     /// Raw points in the frame.
     pub points_in: usize,
     /// Points after pre-processing.
     pub points_used: usize,
+    /// Why the frame is degraded or lost (empty when tracking).
+    pub reason: String,
 }
 
 /// Summary of one mode (the columns of seed 000 Tables 2-3).
@@ -267,8 +273,14 @@ fn track_frame(tracker: &mut Tracker, frame: &Frame, index: usize) -> Result<Fra
         pos_err_cm: if has_pose { pos * 100.0 } else { f64::NAN },
         time_ms: out.timings.total_ms,
         iterations: out.iterations(),
+        cost_mean: out.registration.as_ref().map_or(f64::NAN, |r| r.cost.mean),
+        inlier_fraction: out
+            .registration
+            .as_ref()
+            .map_or(f64::NAN, |r| r.inlier_fraction()),
         points_in: out.points_in,
         points_used: out.points_used,
+        reason: out.reason,
     })
 }
 
@@ -399,7 +411,7 @@ pub fn run(args: &EvalTrackingArgs) -> Result<()> {
         frames: args.frames.map(|f| f as usize),
         seed: args.seed,
         compression: args.compression,
-        first_frame: 0,
+        first_frame: args.first_frame,
         target: (args.target.clone(), args.scale),
         warmup: args.warmup,
     };
