@@ -44,15 +44,27 @@ impl ScanTimes {
     }
 }
 
-/// `interp(T^s, T^e, u)` of Eq. (13): linear in position, slerp in attitude,
-/// `R^u = Exp(u Log(R^e (R^s)⁻¹)) R^s`. `u` outside `[0, 1]` extrapolates at
-/// constant velocity.
+/// `interp(T^s, T^e, u)`: the pose of Eq. (13) at interpolation factor `u`,
+/// for `T = t_target_sensor`. The attitude is the slerp of Eq. (13),
+/// `R^u = Exp(u Log(R^e (R^s)⁻¹)) R^s`. The translation differs from the
+/// paper's literal `(1-u) p^s + u p^e`: we interpolate linearly the target's
+/// centre of mass in the sensor frame, `c = -Rᵀ p`, the constant-velocity
+/// motion of Eq. (8), and set `p^u = -R^u c(u)`.
+///
+/// Why: `p` of `t_target_sensor` is the sensor origin seen from the target,
+/// which moves on an arc of radius ‖c‖ while the target turns; the chord of
+/// the literal formula is off by ‖c‖ (1 - cos(θ/2)) mid-scan, 5.7 cm at
+/// 15 m for a 10° turn per scan, close to the 7.5 cm association distance.
+/// The rotation part, and so Eq. (15)'s rotation block at `c = 0`, are
+/// unchanged; the Jacobian gains the terms of [`ct_point_jacobian`].
+/// `u` outside `[0, 1]` extrapolates at constant velocity.
 pub fn interpolate(start: &Pose, end: &Pose, u: f64) -> Pose {
     let phi = so3::log(&(end.rotation * start.rotation.inverse()));
-    Pose::new(
-        so3::exp(&(phi * u)) * start.rotation,
-        start.translation * (1.0 - u) + end.translation * u,
-    )
+    let r_u = so3::exp(&(phi * u)) * start.rotation;
+    let c_start = -(start.rotation.inverse() * start.translation);
+    let c_end = -(end.rotation.inverse() * end.translation);
+    let c_u = c_start * (1.0 - u) + c_end * u;
+    Pose::new(r_u, -(r_u * c_u))
 }
 
 /// The coefficients `a = sin θ/θ`, `b = (1 - cos θ)/θ²`, `c = (θ - sin θ)/θ³`
@@ -79,10 +91,19 @@ fn exp_coefficients(theta2: f64) -> (f64, f64, f64) {
 
 /// What every point shares within one linearisation at `T^e`.
 struct Interpolation {
-    p_start: Vector3<f64>,
-    p_end: Vector3<f64>,
+    /// `R^s c^s = -p^s` and `R^s c^e`: the centre of mass at both ends,
+    /// rotated by `R^s` (points are stored as `w = R^s z`).
+    q_start: Vector3<f64>,
+    q_end: Vector3<f64>,
     /// `φ = Log Q`, `Q = R^e (R^s)⁻¹`.
     phi: Vector3<f64>,
+    /// `φ^×` and `(φ^×)²`, for `R^u (R^e)ᵀ = Exp((u-1)φ)`.
+    k1: Matrix3<f64>,
+    k2: Matrix3<f64>,
+    /// `(p^e)^×`, `φ^× (p^e)^×`, `(φ^×)² (p^e)^×`, for `Exp((u-1)φ) (p^e)^×`.
+    p0: Matrix3<f64>,
+    p1: Matrix3<f64>,
+    p2: Matrix3<f64>,
     /// `D_log(Q)`, `φ^× D_log(Q)` and `(φ^×)² D_log(Q)`: with
     /// `D_exp(uφ) = I + b u φ^× + c u² (φ^×)²`, the product
     /// `D_exp(uφ) D_log(Q)` is a per-point combination of these three.
@@ -91,37 +112,62 @@ struct Interpolation {
     l2: Matrix3<f64>,
 }
 
+/// Per point: the transformed point and the two Jacobian blocks.
+struct Linearised {
+    point: Vector3<f64>,
+    j_r: Matrix3<f64>,
+    j_t: Matrix3<f64>,
+}
+
 impl Interpolation {
     fn new(start: &Pose, end: &Pose) -> Self {
         let phi = so3::log(&(end.rotation * start.rotation.inverse()));
-        let k = so3::hat(&phi);
+        let k1 = so3::hat(&phi);
+        let k2 = k1 * k1;
         let l0 = so3::d_exp_inv(&phi);
-        let l1 = k * l0;
+        let c_end = -(end.rotation.inverse() * end.translation);
+        let p0 = so3::hat(&end.translation);
         Self {
-            p_start: start.translation,
-            p_end: end.translation,
+            q_start: -start.translation,
+            q_end: start.rotation * c_end,
             phi,
+            k1,
+            k2,
+            p0,
+            p1: k1 * p0,
+            p2: k2 * p0,
             l0,
-            l1,
-            l2: k * l1,
+            l1: k1 * l0,
+            l2: k2 * l0,
         }
     }
 
-    /// `(R^u z, T_u(z), D_exp(u Log Q) D_log(Q))` for one point given
-    /// `w = R^s z`: `R^u z = Exp(uφ) w` by Rodrigues on the vector.
+    /// The point `T_u(z) = R^u (z - c(u))` and its Jacobian for one point
+    /// given `w = R^s z`, with `R^u y = Exp(uφ) R^s y` by Rodrigues on the
+    /// vector.
     #[inline]
-    fn apply(&self, w: &Vector3<f64>, u: f64) -> (Vector3<f64>, Vector3<f64>, Matrix3<f64>) {
+    fn apply(&self, w: &Vector3<f64>, u: f64) -> Linearised {
         let x = self.phi * u;
         let (a, b, c) = exp_coefficients(x.norm_squared());
-        let xw = x.cross(w);
-        let rz = w + xw * a + x.cross(&xw) * b;
-        let point = rz + self.p_start * (1.0 - u) + self.p_end * u;
+        let y = w - (self.q_start * (1.0 - u) + self.q_end * u);
+        let xy = x.cross(&y);
+        let point = y + xy * a + x.cross(&xy) * b;
         let d = self.l0 + self.l1 * (b * u) + self.l2 * (c * u * u);
-        (rz, point, d)
+        // Exp((u-1)φ) = I + a' (u-1) φ^× + b' (u-1)² (φ^×)².
+        let v = u - 1.0;
+        let (a2, b2, _) = exp_coefficients(self.phi.norm_squared() * v * v);
+        let (s1, s2) = (a2 * v, b2 * v * v);
+        let m = Matrix3::identity() + self.k1 * s1 + self.k2 * s2;
+        let m_p = self.p0 + self.p1 * s1 + self.p2 * s2;
+        Linearised {
+            point,
+            j_r: Self::rotation_block(&point, &d, u) + m_p * u,
+            j_t: m * u,
+        }
     }
 
-    /// Rotation block of Eq. (15): `-(R^u z)^× u D_exp(u Log Q) D_log(Q)`,
-    /// column by column as cross products.
+    /// `-(R^u y)^× u D_exp(u Log Q) D_log(Q)`, the rotation block of
+    /// Eq. (15), column by column as cross products.
     #[inline]
     fn rotation_block(rz: &Vector3<f64>, d_exp_d_log: &Matrix3<f64>, u: f64) -> Matrix3<f64> {
         let m = d_exp_d_log * (-u);
@@ -133,16 +179,17 @@ impl Interpolation {
     }
 }
 
-/// The Jacobian of Eq. (15), `D interp(T^s, T^e, u)(z) / D T^e`, for the left
-/// perturbation `δ ⊕ T^e`, `δ = [rot; trans]`.
+/// The Jacobian `D interp(T^s, T^e, u)(z) / D T^e` for the left
+/// perturbation `δ ⊕ T^e`, `δ = [rot; trans]`, of [`interpolate`]:
+/// `[-(R^u y)^× u D_exp(u Log Q) D_log(Q) + u R^u (R^e)ᵀ (p^e)^×,
+///   u R^u (R^e)ᵀ]` with `y = z - c(u)`. The first term is Eq. (15)'s
+/// rotation block; the others come from the centre of mass interpolated in
+/// the sensor frame (see [`interpolate`]). At `u = 1` it is Eq. (6).
 pub fn ct_point_jacobian(start: &Pose, end: &Pose, u: f64, z: &Vector3<f64>) -> Matrix3x6<f64> {
-    let interp = Interpolation::new(start, end);
-    let (rz, _, d) = interp.apply(&(start.rotation * z), u);
+    let l = Interpolation::new(start, end).apply(&(start.rotation * z), u);
     let mut j = Matrix3x6::zeros();
-    j.fixed_view_mut::<3, 3>(0, 0)
-        .copy_from(&Interpolation::rotation_block(&rz, &d, u));
-    j.fixed_view_mut::<3, 3>(0, 3)
-        .copy_from(&(Matrix3::identity() * u));
+    j.fixed_view_mut::<3, 3>(0, 0).copy_from(&l.j_r);
+    j.fixed_view_mut::<3, 3>(0, 3).copy_from(&l.j_t);
     j
 }
 
@@ -159,11 +206,10 @@ fn linearise(
     let mut ne = NormalEquations::new();
     // `points` holds `(R^s z, u)`.
     for (w, u) in points.iter().step_by(stride.max(1)) {
-        let (rz, x, d) = interp.apply(w, *u);
-        if let Some((k, _)) = map.nearest_cell(&x, params.max_distance_m, params.lookup) {
+        let l = interp.apply(w, *u);
+        if let Some((k, _)) = map.nearest_cell(&l.point, params.max_distance_m, params.lookup) {
             let (mean, information) = map.mean_and_information(k);
-            let a = Interpolation::rotation_block(&rz, &d, *u);
-            ne.add(&a, *u, information, &(x - mean));
+            ne.add_general(&l.j_r, &l.j_t, information, &(l.point - mean));
         }
     }
     ne

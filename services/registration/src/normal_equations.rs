@@ -36,17 +36,23 @@ impl NormalEquations {
         }
     }
 
-    /// Adds the term of residual `r = T(z) - μ` with information `P` and
-    /// Jacobian `J = [a  s·I₃]` (`a` the 3×3 rotation block).
-    #[inline(always)]
-    pub(crate) fn add(&mut self, a: &Matrix3<f64>, s: f64, p: &Matrix3<f64>, r: &Vector3<f64>) {
-        let pa = p * a;
+    /// Accumulates one residual `r` with information `p` and the general
+    /// Jacobian `[j_r  j_t]` (rotation and translation blocks).
+    pub(crate) fn add_general(
+        &mut self,
+        j_r: &Matrix3<f64>,
+        j_t: &Matrix3<f64>,
+        p: &Matrix3<f64>,
+        r: &Vector3<f64>,
+    ) {
         let pr = p * r;
-        self.h_rr += a.tr_mul(&pa);
-        self.h_rt += pa.transpose() * s;
-        self.h_tt += p * (s * s);
-        self.g_r += a.tr_mul(&pr);
-        self.g_t += pr * s;
+        let pjr = p * j_r;
+        let pjt = p * j_t;
+        self.h_rr += j_r.tr_mul(&pjr);
+        self.h_rt += j_r.tr_mul(&pjt);
+        self.h_tt += j_t.tr_mul(&pjt);
+        self.g_r += j_r.tr_mul(&pr);
+        self.g_t += j_t.tr_mul(&pr);
         self.cost += r.dot(&pr);
         self.squared_distance += r.norm_squared();
         self.inliers += 1;
