@@ -137,6 +137,8 @@ fn prediction(
         attitude: Some(AttitudePrediction {
             r_sensor_target: e_rot * before.rotation,
             w_target: truth.w_target,
+            sigma_rot_rad: 0.0,
+            sigma_w_radps: 0.0,
         }),
     }
 }

@@ -211,8 +211,19 @@ fn from_filter_state(s: &FilterState) -> Result<TargetPrediction, String> {
         attitude: Some(AttitudePrediction {
             r_sensor_target: r,
             w_target: vector3_from_wire(&s.w_target),
+            sigma_rot_rad: worst_sigma(&s.attitude_covariance, 0),
+            sigma_w_radps: worst_sigma(&s.attitude_covariance, 3),
         }),
     })
+}
+
+/// Square root of the largest diagonal entry of the 3×3 block starting at
+/// `first` of a 6×6 covariance (the worst-axis standard deviation).
+fn worst_sigma(covariance: &[[f64; 6]; 6], first: usize) -> f64 {
+    (first..first + 3)
+        .map(|i| covariance[i][i])
+        .fold(0.0_f64, f64::max)
+        .sqrt()
 }
 
 /// An acquired pose gives the position only: its velocities are unknown, so

@@ -43,6 +43,18 @@ pub struct AttitudePrediction {
     /// Angular velocity of the target relative to the sensor, body frame
     /// (rad/s): `R(t) = R(t_s) Exp(ω (t - t_s))` (seed 000 Eq. 9).
     pub w_target: Vector3<f64>,
+    /// Attitude uncertainty at `t_s`, worst axis (rad, 1σ).
+    pub sigma_rot_rad: f64,
+    /// Angular-velocity uncertainty, worst axis (rad/s, 1σ).
+    pub sigma_w_radps: f64,
+}
+
+impl AttitudePrediction {
+    /// Worst-axis attitude uncertainty propagated to `dt_s` after `t_s`
+    /// (rad, 1σ): `sqrt(σ_R² + (σ_ω dt)²)`.
+    pub fn sigma_at(&self, dt_s: f64) -> f64 {
+        (self.sigma_rot_rad.powi(2) + (self.sigma_w_radps * dt_s).powi(2)).sqrt()
+    }
 }
 
 impl TargetPrediction {
@@ -53,7 +65,10 @@ impl TargetPrediction {
             && finite(&self.p_sensor_target)
             && finite(&self.v_sensor)
             && self.attitude.as_ref().is_none_or(|a| {
-                finite(&a.w_target) && a.r_sensor_target.matrix().iter().all(|x| x.is_finite())
+                finite(&a.w_target)
+                    && a.r_sensor_target.matrix().iter().all(|x| x.is_finite())
+                    && a.sigma_rot_rad.is_finite()
+                    && a.sigma_w_radps.is_finite()
             })
     }
 
@@ -191,7 +206,17 @@ impl Roi {
             + pred.v_sensor.norm() * (scan_end_s - scan_start_s).max(0.0);
         roi.sphere = Some((centre, radius * radius));
         roi.static_box = None;
-        roi.oriented = config.body_box.and_then(|b| {
+        // The body box sits at the predicted attitude: it is only used when
+        // that attitude is known well enough that a 3σ error moves the
+        // target's farthest point by less than the margin. Before the filter
+        // has learnt the spin (seed 000 §5.2) a misplaced box would cut the
+        // target itself, and each worse registration would misplace the next
+        // box further; the sphere alone is safe then.
+        let trusted = pred.attitude.as_ref().is_some_and(|a| {
+            3.0 * a.sigma_at(scan_end_s - pred.t_s) * config.target_bounding_radius_m
+                < config.margin_m
+        });
+        roi.oriented = config.body_box.filter(|_| trusted).and_then(|b| {
             OrientedBox::new(b.grown(config.margin_m), pred, scan_start_s, scan_end_s)
         });
         (roi, None)
@@ -297,6 +322,8 @@ mod tests {
             attitude: Some(AttitudePrediction {
                 r_sensor_target: Rotation3::identity(),
                 w_target: Vector3::new(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+                sigma_rot_rad: 0.0,
+                sigma_w_radps: 0.0,
             }),
         };
         let (roi, _) = Roi::for_frame(&c, Some(&p), 0.0, 1.0);
@@ -308,6 +335,17 @@ mod tests {
         assert!(!roi.contains(&Point::new(1.4, 0.0, 10.0, 1.0, 1.0)));
         // A point below the target (an arm) is inside the sphere, not the box.
         assert!(!roi.contains(&Point::new(0.0, 0.9, 10.0, 1.0, 0.0)));
+        // An attitude too uncertain for the margin (3 × 2° × 1.6 m > 0.1 m
+        // after 1 s): the sphere alone, so a wrong box cannot cut the target.
+        let unsure = TargetPrediction {
+            attitude: p.attitude.map(|a| AttitudePrediction {
+                sigma_w_radps: 2f64.to_radians(),
+                ..a
+            }),
+            ..p
+        };
+        let (roi, _) = Roi::for_frame(&c, Some(&unsure), 0.0, 1.0);
+        assert_eq!(roi.kind(), RoiKind::Predicted);
         // Without an attitude, the sphere alone.
         let (roi, _) = Roi::for_frame(
             &c,
