@@ -11,7 +11,15 @@ use serde::{Deserialize, Serialize};
 /// `t` is the acquisition time in seconds on the sensor clock.
 #[repr(C)]
 #[derive(
-    Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize, bytemuck::Pod, bytemuck::Zeroable,
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Default,
+    Serialize,
+    Deserialize,
+    bytemuck::Pod,
+    bytemuck::Zeroable,
 )]
 pub struct Point {
     /// x coordinate (m).
