@@ -4,14 +4,21 @@
 //! sources) truth on iceoryx2, and publishes them as JSON on zenoh under
 //! `spacepose/{prefix}/telemetry/`, with the errors against truth and a
 //! queryable `latest`. Logic: [`TelemetryHub`]; schema: `TELEMETRY.md`.
+//!
+//! It also hosts the ground -> suite command path: a [`Bridge`] forwards
+//! postcard `Command`s from `spacepose/{prefix}/wire/command` to the
+//! iceoryx2 command topic; payloads the codec refuses are counted in this
+//! service's `rejected_wire` health counter.
 
 use anyhow::Context;
 use clap::Parser;
 use serde::Deserialize;
 use spacepose_bus::zenoh::Wait;
 use spacepose_bus::zenoh::bytes::Encoding;
-use spacepose_bus::{Bus, Msg, Subscriber, WakeReason, ZenohConfig, open_zenoh, zenoh};
-use spacepose_messages::{FilterState, Health, Names, PoseEstimate, ServiceState, TruthMsg};
+use spacepose_bus::{
+    Bridge, Bus, Msg, Route, Subscriber, WakeReason, ZenohConfig, open_zenoh, zenoh,
+};
+use spacepose_messages::{FilterState, Health, Names, PoseEstimate, ServiceState, Topic, TruthMsg};
 use spacepose_service_kit::{
     Counters, HealthReporter, ServiceArgs, ServiceConfig, init_logging, load_config, shutdown_flag,
 };
@@ -128,6 +135,7 @@ fn run(args: ServiceArgs) -> anyhow::Result<()> {
     let _queryable = declare_latest(&session, &names, Arc::clone(&latest))?;
 
     let bus = Bus::open(&names, &instance).context("opening the bus")?;
+    let mut commands = CommandBridge::start(&names, &session)?;
     let ports = Ports {
         poses: bus.subscriber(&names.pose())?,
         states: bus.subscriber(&names.filter_state())?,
@@ -173,6 +181,7 @@ fn run(args: ServiceArgs) -> anyhow::Result<()> {
         });
         drain(&ports.states, &mut counters, |m, c| go(hub.on_filter(m), c));
         drain(&ports.health, &mut counters, |m, c| go(hub.on_health(m), c));
+        commands.report(&mut counters);
         match (hub.latest_json(), latest.lock()) {
             (Ok(json), Ok(mut slot)) => *slot = json,
             _ => counters.errors += 1,
@@ -180,8 +189,59 @@ fn run(args: ServiceArgs) -> anyhow::Result<()> {
         health.tick(&counters, ServiceState::Running as u8)?;
     }
     tracing::info!("telemetry service stopping");
+    commands.report(&mut counters);
     health.send(&counters, ServiceState::Stopping as u8)?;
+    commands
+        .bridge
+        .stop()
+        .context("stopping the command bridge")?;
     Ok(())
+}
+
+/// The zenoh -> iceoryx2 command path, and how much of its counters this
+/// service has already reported.
+struct CommandBridge {
+    bridge: Bridge,
+    rejected_seen: u64,
+    stopped_seen: bool,
+}
+
+impl CommandBridge {
+    fn start(names: &Names, session: &zenoh::Session) -> anyhow::Result<CommandBridge> {
+        let bridge = Bridge::start(names, session, &[Route::from_zenoh(Topic::Command)])
+            .context("starting the zenoh -> iceoryx2 command bridge")?;
+        tracing::info!(
+            key = names.wire_key(Topic::Command),
+            "accepting commands from zenoh"
+        );
+        Ok(CommandBridge {
+            bridge,
+            rejected_seen: 0,
+            stopped_seen: false,
+        })
+    }
+
+    /// Adds the payloads the bridge refused since the last call to
+    /// `counters.rejected_wire` (one warning per batch; the bridge itself
+    /// logs each one), and counts a stopped bridge once as an error.
+    fn report(&mut self, counters: &mut Counters) {
+        let stats = self.bridge.stats();
+        let new = stats.rejected_wire.saturating_sub(self.rejected_seen);
+        if new > 0 {
+            self.rejected_seen = stats.rejected_wire;
+            counters.rejected_wire += new;
+            tracing::warn!(
+                new,
+                total = stats.rejected_wire,
+                "zenoh command payloads rejected (garbage, wrong schema version or kind)"
+            );
+        }
+        if !self.stopped_seen && !self.bridge.is_running() {
+            self.stopped_seen = true;
+            counters.errors += 1;
+            tracing::error!("the command bridge stopped: zenoh commands are no longer forwarded");
+        }
+    }
 }
 
 /// Drains `sub`, handing every message to `handle`; receive errors are counted.
