@@ -4,28 +4,13 @@
 use spacepose_bus::{Bus, CloudSubscriber, Subscriber};
 use spacepose_geometry::Point;
 use spacepose_messages::{CloudHeader, FilterState, Health, Names, ServiceState};
-use std::process::{Child, Command};
-use std::time::{Duration, Instant};
+use spacepose_service_kit::testing::{self, ChildGuard};
+use std::process::Command;
+use std::time::Duration;
 
-/// Kills the child if the test fails before stopping it.
-struct Guard(Child);
-
-impl Drop for Guard {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-fn wait_for<T>(what: &str, mut f: impl FnMut() -> Option<T>) -> T {
-    let start = Instant::now();
-    while start.elapsed() < Duration::from_secs(20) {
-        if let Some(v) = f() {
-            return v;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    panic!("timed out waiting for {what}");
+/// Polls until `f` gives a value (20 s at most).
+fn wait_for<T>(what: &str, f: impl FnMut() -> Option<T>) -> T {
+    testing::wait_for(what, Duration::from_secs(20), f)
 }
 
 /// The latest health message once `pred` holds for it.
@@ -72,11 +57,7 @@ fn scene(n: usize, t0: f64) -> Vec<Point> {
 
 #[test]
 fn ingest_crops_counts_bad_frames_and_keeps_going() {
-    let prefix = format!(
-        "ingest{}x{}",
-        std::process::id(),
-        Instant::now().elapsed().as_nanos() % 1000
-    );
+    let prefix = testing::unique_prefix("ingest");
     let names = Names::new(&prefix).unwrap();
     let bus = Bus::open(&names, "ingest-test").unwrap();
     let health = bus.subscriber::<Health>(&names.health()).unwrap();
@@ -92,7 +73,7 @@ fn ingest_crops_counts_bad_frames_and_keeps_going() {
         .arg(&config)
         .spawn()
         .unwrap();
-    let mut guard = Guard(child);
+    let mut guard = ChildGuard(child);
     health_until(&health, "the first heartbeat", |h| {
         h.state == ServiceState::Running as u8 && h.service.as_str() == "ingest"
     });

@@ -4,37 +4,18 @@
 use spacepose_bus::Bus;
 use spacepose_messages::convert::pose_from_wire;
 use spacepose_messages::{AcquisitionResult, Health, Names, ServiceState, TruthMsg};
-use std::process::{Child, Command};
-use std::time::{Duration, Instant};
+use spacepose_service_kit::testing::{self, ChildGuard};
+use std::process::Command;
+use std::time::Duration;
 
-/// Kills the child if the test fails before stopping it.
-struct Guard(Child);
-
-impl Drop for Guard {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-fn wait_for<T>(what: &str, mut f: impl FnMut() -> Option<T>) -> T {
-    let start = Instant::now();
-    while start.elapsed() < Duration::from_secs(60) {
-        if let Some(v) = f() {
-            return v;
-        }
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    panic!("timed out waiting for {what}");
+/// Polls until `f` gives a value (60 s at most).
+fn wait_for<T>(what: &str, f: impl FnMut() -> Option<T>) -> T {
+    testing::wait_for(what, Duration::from_secs(60), f)
 }
 
 #[test]
 fn lidar_sim_publishes_frames_truth_and_the_truth_acquisition() {
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .unwrap()
-        .subsec_nanos();
-    let prefix = format!("sim{}x{nanos}", std::process::id());
+    let prefix = testing::unique_prefix("sim");
     let names = Names::new(&prefix).unwrap();
     let bus = Bus::open(&names, "sim-test").unwrap();
     let health = bus.subscriber::<Health>(&names.health()).unwrap();
@@ -54,7 +35,7 @@ fn lidar_sim_publishes_frames_truth_and_the_truth_acquisition() {
         .arg(&config)
         .spawn()
         .unwrap();
-    let mut guard = Guard(child);
+    let mut guard = ChildGuard(child);
 
     let mut frames = Vec::new();
     while frames.len() < 3 {

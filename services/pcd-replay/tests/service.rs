@@ -4,28 +4,13 @@
 use spacepose_bus::Bus;
 use spacepose_geometry::{CloudFormat, Point, write_cloud};
 use spacepose_messages::{Health, Names, ServiceState};
-use std::process::{Child, Command};
-use std::time::{Duration, Instant};
+use spacepose_service_kit::testing::{self, ChildGuard};
+use std::process::Command;
+use std::time::Duration;
 
-/// Kills the child if the test fails before stopping it.
-struct Guard(Child);
-
-impl Drop for Guard {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-fn wait_for<T>(what: &str, mut f: impl FnMut() -> Option<T>) -> T {
-    let start = Instant::now();
-    while start.elapsed() < Duration::from_secs(20) {
-        if let Some(v) = f() {
-            return v;
-        }
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    panic!("timed out waiting for {what}");
+/// Polls until `f` gives a value (20 s at most).
+fn wait_for<T>(what: &str, f: impl FnMut() -> Option<T>) -> T {
+    testing::wait_for(what, Duration::from_secs(20), f)
 }
 
 fn frame(k: usize) -> Vec<Point> {
@@ -44,11 +29,7 @@ fn frame(k: usize) -> Vec<Point> {
 
 #[test]
 fn replay_publishes_frames_in_order_skips_corrupt_files_and_loops() {
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .unwrap()
-        .subsec_nanos();
-    let prefix = format!("replay{}x{nanos}", std::process::id());
+    let prefix = testing::unique_prefix("replay");
     let names = Names::new(&prefix).unwrap();
     let bus = Bus::open(&names, "replay-test").unwrap();
     let health = bus.subscriber::<Health>(&names.health()).unwrap();
@@ -74,7 +55,7 @@ fn replay_publishes_frames_in_order_skips_corrupt_files_and_loops() {
         .arg(&config)
         .spawn()
         .unwrap();
-    let mut guard = Guard(child);
+    let mut guard = ChildGuard(child);
 
     let mut got = Vec::new();
     while got.len() < 5 {

@@ -13,6 +13,7 @@ pub mod config;
 pub mod counters;
 pub mod health;
 pub mod runtime;
+pub mod testing;
 
 pub use args::ServiceArgs;
 pub use config::{ServiceConfig, load_config};
