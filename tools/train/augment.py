@@ -34,7 +34,7 @@ class AugmentConfig:
     p_points: float = 0.4
     points_density: float = 0.01   # max fraction of pixels turned into outliers
     p_surface: float = 0.3
-    surface_frac: tuple[float, float] = (1 / 8, 1 / 2)  # ellipse semi-axis, fraction of N
+    surface_frac: tuple[float, float] = (1 / 16, 1 / 4)  # ellipse semi-axis, fraction of N
 
     def to_dict(self) -> dict:
         return asdict(self)

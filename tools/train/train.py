@@ -41,7 +41,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--data", required=True, help="training set directory")
     p.add_argument("--val", required=True, help="validation set directory")
     p.add_argument("--out", required=True, help="output directory (model.onnx, model.json, log)")
-    p.add_argument("--epochs", type=int, default=30)
+    p.add_argument("--epochs", type=int, default=40)
     p.add_argument("--threads", type=int, default=1,
                    help="torch intra-op threads; under load 1 beats 2 (README)")
     p.add_argument("--max-minutes", type=float, default=None,
@@ -52,7 +52,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--weight-decay", type=float, default=0.02)
     p.add_argument("--warmup", type=float, default=0.03, help="warm-up fraction of training")
     p.add_argument("--lam", type=float, default=10.0, help="λ of Eq. (16)")
-    p.add_argument("--width", type=float, default=0.5, help="MobileNetV3-Small width_mult")
+    p.add_argument("--width", type=float, default=0.75, help="MobileNetV3-Small width_mult")
     p.add_argument("--dropout", type=float, default=0.2)
     p.add_argument("--no-augment", action="store_true", help="disable the §IV.B augmentations")
     p.add_argument("--train-limit", type=int, default=None, help="use the first K images only")
