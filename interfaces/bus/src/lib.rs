@@ -9,10 +9,12 @@
 //! - [`open_zenoh`]: a zenoh session (peer, explicit endpoints, loopback,
 //!   no multicast scouting).
 //! - [`Bridge`]: allow-listed iceoryx2 <-> zenoh forwarding in the postcard codec.
+//! - [`AccessControl`]/[`Credentials`]: usrpwd authentication and an ACL by
+//!   username on the ground link (who reads telemetry, who sends commands).
 //!
-//! zenoh is built with `default-features = false, features = ["transport_tcp"]`
-//! for the whole workspace; liveliness, queryables and the synchronous API
-//! (`zenoh::Wait`) are part of that build.
+//! zenoh is built with `default-features = false, features = ["transport_tcp",
+//! "auth_usrpwd"]` for the whole workspace; liveliness, queryables, the
+//! access control and the synchronous API (`zenoh::Wait`) are part of that build.
 
 pub mod bridge;
 pub mod cloud;
@@ -21,6 +23,7 @@ pub mod limits;
 pub mod node;
 pub mod pubsub;
 pub mod waiter;
+pub mod zenoh_access;
 pub mod zenoh_session;
 
 pub use bridge::{Bridge, BridgeStats, Direction, Route};
@@ -29,7 +32,10 @@ pub use error::BusError;
 pub use node::{Bus, cleanup_dead_nodes, iceoryx2_config};
 pub use pubsub::{Msg, Publisher, Subscriber, Wakeable};
 pub use waiter::{Waiter, WakeReason};
-pub use zenoh_session::{DEFAULT_ZENOH_PORT, ZenohConfig, open_zenoh};
+pub use zenoh_access::{AccessControl, Credentials};
+pub use zenoh_session::{
+    DEFAULT_ZENOH_PORT, ZenohConfig, is_loopback_endpoint, open_zenoh, open_zenoh_with,
+};
 
 /// Re-export of zenoh for services (same version and features as the bus).
 pub use zenoh;

@@ -87,7 +87,90 @@ impl ZenohConfig {
 
 /// Opens a zenoh session with `config`.
 pub fn open_zenoh(config: &ZenohConfig) -> Result<zenoh::Session, BusError> {
-    zenoh::open(config.to_zenoh()?)
+    open_zenoh_with(config, |_| Ok(()))
+}
+
+/// Opens a zenoh session with `config`, after `extra` has amended the zenoh
+/// configuration (e.g. [`crate::AccessControl::apply`] or
+/// [`crate::Credentials::apply`]).
+pub fn open_zenoh_with(
+    config: &ZenohConfig,
+    extra: impl FnOnce(&mut zenoh::Config) -> Result<(), BusError>,
+) -> Result<zenoh::Session, BusError> {
+    let mut c = config.to_zenoh()?;
+    extra(&mut c)?;
+    zenoh::open(c)
         .wait()
         .map_err(|e| BusError::Zenoh(format!("opening session: {e}")))
+}
+
+/// True for an endpoint on a loopback address (`127.0.0.0/8`, `[::1]`,
+/// `localhost`), e.g. `tcp/127.0.0.1:7447`. Anything else, including
+/// `0.0.0.0` and `[::]` (every interface), is reachable from the network.
+pub fn is_loopback_endpoint(endpoint: &str) -> bool {
+    let Some((_, address)) = endpoint.split_once('/') else {
+        return false;
+    };
+    // Drop zenoh endpoint metadata/config (`?...`, `#...`).
+    let address = address.split(['?', '#']).next().unwrap_or(address);
+    let host = match address.rsplit_once(':') {
+        Some((host, _port)) => host,
+        None => address,
+    };
+    let host = host.trim_start_matches('[').trim_end_matches(']');
+    if host == "localhost" {
+        return true;
+    }
+    host.parse::<std::net::IpAddr>()
+        .is_ok_and(|ip| ip.is_loopback())
+}
+
+impl ZenohConfig {
+    /// The listen endpoints that are not on a loopback address.
+    pub fn non_loopback_listen(&self) -> Vec<&str> {
+        self.listen
+            .iter()
+            .map(String::as_str)
+            .filter(|e| !is_loopback_endpoint(e))
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_listen_on_loopback_only() {
+        assert!(ZenohConfig::default().non_loopback_listen().is_empty());
+        assert!(ZenohConfig::loopback(9000).non_loopback_listen().is_empty());
+        for e in [
+            "tcp/127.0.0.1:7447",
+            "tcp/127.3.0.1:1",
+            "tcp/[::1]:7447",
+            "tcp/localhost:7447",
+        ] {
+            assert!(is_loopback_endpoint(e), "{e}");
+        }
+        for e in [
+            "tcp/0.0.0.0:7447",
+            "tcp/[::]:7447",
+            "tcp/10.0.0.2:7447",
+            "tcp/ground.example:7447",
+            "garbage",
+        ] {
+            assert!(!is_loopback_endpoint(e), "{e}");
+        }
+        let mut c = ZenohConfig::default();
+        c.listen.push("tcp/0.0.0.0:7448".into());
+        assert_eq!(c.non_loopback_listen(), ["tcp/0.0.0.0:7448"]);
+        // The zenoh configuration really carries the loopback endpoint.
+        let z = ZenohConfig::default().to_zenoh().unwrap();
+        assert!(
+            z.get_json("listen/endpoints")
+                .unwrap()
+                .contains("127.0.0.1:7447")
+        );
+        assert_eq!(z.get_json("scouting/multicast/enabled").unwrap(), "false");
+    }
 }

@@ -149,7 +149,15 @@ impl Worker {
             Ok(()) => Counters::bump(&self.counters.forwarded_from_zenoh),
             Err(InjectError::Codec(e)) => {
                 Counters::bump(&self.counters.rejected_wire);
-                tracing::warn!(topic, len = bytes.len(), error = %e, "rejected zenoh payload");
+                // Every rejection is counted; the log is throttled (the first
+                // ten, then the 16th, 32nd, ...) so a flood of garbage cannot
+                // flood the log as well.
+                let n = self.counters.rejected_wire.load(Ordering::Relaxed);
+                if n <= 10 || n.is_power_of_two() {
+                    tracing::warn!(topic, len = bytes.len(), error = %e, rejected = n, "rejected zenoh payload");
+                } else {
+                    tracing::debug!(topic, len = bytes.len(), error = %e, rejected = n, "rejected zenoh payload");
+                }
             }
             Err(InjectError::Bus(e)) => {
                 Counters::bump(&self.counters.errors);
