@@ -1,0 +1,184 @@
+//! Parameters of template matching, refinement and failure detection.
+
+use crate::error::AcquisitionError;
+use serde::{Deserialize, Serialize};
+use spacepose_registration::IcpParams;
+
+/// Where the templates are evaluated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Threads {
+    /// On the calling thread only (fair timing, seed 002's single CPU).
+    Single,
+    /// In parallel over templates on rayon's global pool.
+    #[default]
+    All,
+}
+
+/// Coarse-to-fine template evaluation (a speed-up, not in seed 002): every
+/// grid attitude is first rendered with the sensor's rays thinned by
+/// `stride` and correlated; only the `keep` best are rendered again with
+/// every ray and ranked by the full C.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct CoarseToFine {
+    /// Ray thinning of the first pass (every `stride`-th raster row and column).
+    pub stride: usize,
+    /// Templates kept for the full-resolution pass.
+    pub keep: usize,
+}
+
+/// Template matching (seed 002 §2), ICP refinement and the f_CONV check (§4.5).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TemplateMatchingConfig {
+    /// Δ, the Euler-angle sampling step (deg). Seed 002: 30° is the best
+    /// compromise.
+    pub delta_deg: f64,
+    /// The on-line fast-TM variant (§2.2): skip templates failing Eq. (3).
+    pub fast: bool,
+    /// τ of Eq. (3). Seed 002: 0.1.
+    pub tau: f64,
+    /// Position from the trimmed centroid (seed 004 §III.A.1) instead of the
+    /// mean; the same estimator centres the templates.
+    pub trimmed_centroid: bool,
+    /// Trim factor of the trimmed centroid (seed 004: 0.25).
+    pub trim: f64,
+    /// Parallel or single-threaded template evaluation.
+    pub threads: Threads,
+    /// f_MAX (m²): a solution is accepted when f_CONV ≤ f_MAX (§4.5).
+    pub f_max_m2: f64,
+    /// Final ICP stage (correspondence distance, iterations, termination).
+    pub icp: IcpParams,
+    /// Correspondence distances (m) of the ICP stages run before `icp`,
+    /// widest first: the template solution can be tens of degrees and
+    /// metres off, beyond the final 10 cm.
+    pub icp_stages_m: Vec<f64>,
+    /// Maximum iterations of each wide stage.
+    pub icp_stage_iterations: usize,
+    /// Ray thinning of every template (1 = the sensor's own rays).
+    pub template_stride: usize,
+    /// Optional coarse first pass.
+    pub coarse_to_fine: Option<CoarseToFine>,
+    /// Sensor points used in Eq. (1) (0 = all; else an even subsample).
+    pub max_correlation_points: usize,
+    /// Best templates (by C) refined by ICP; the lowest f_CONV wins.
+    /// 1 is seed 002 (only the best template is refined).
+    pub icp_candidates: usize,
+    /// Fewer finite points than this is [`AcquisitionError::TooFewPoints`].
+    pub min_points: usize,
+    /// Spacing of the model cloud sampled from the mesh for ICP (m).
+    pub model_spacing_m: f64,
+}
+
+impl Default for TemplateMatchingConfig {
+    fn default() -> Self {
+        Self {
+            delta_deg: 30.0,
+            fast: false,
+            tau: 0.1,
+            trimmed_centroid: false,
+            trim: spacepose_geometry::DEFAULT_TRIM,
+            threads: Threads::All,
+            f_max_m2: 0.02,
+            icp: IcpParams::default(),
+            icp_stages_m: vec![2.0, 0.5],
+            icp_stage_iterations: 30,
+            template_stride: 1,
+            coarse_to_fine: None,
+            max_correlation_points: 0,
+            icp_candidates: 1,
+            min_points: 20,
+            model_spacing_m: 0.03,
+        }
+    }
+}
+
+fn bad(field: &'static str, value: f64, reason: &'static str) -> AcquisitionError {
+    AcquisitionError::InvalidConfig {
+        field,
+        value,
+        reason,
+    }
+}
+
+impl TemplateMatchingConfig {
+    /// Rejects NaN and out-of-domain values.
+    pub fn validate(&self) -> Result<(), AcquisitionError> {
+        crate::grid::euler_grid(self.delta_deg)?;
+        if !(self.tau.is_finite() && self.tau > 0.0) {
+            return Err(bad("tau", self.tau, "must be finite and > 0"));
+        }
+        if !(0.0..0.5).contains(&self.trim) {
+            return Err(bad("trim", self.trim, "must be in [0, 0.5["));
+        }
+        if !(self.f_max_m2.is_finite() && self.f_max_m2 > 0.0) {
+            return Err(bad("f_max_m2", self.f_max_m2, "must be finite and > 0"));
+        }
+        self.icp.validate()?;
+        if let Some(&d) = self
+            .icp_stages_m
+            .iter()
+            .find(|d| !(d.is_finite() && **d > 0.0))
+        {
+            return Err(bad("icp_stages_m", d, "must be finite and > 0"));
+        }
+        if self.icp_stage_iterations == 0 {
+            return Err(bad("icp_stage_iterations", 0.0, "must be >= 1"));
+        }
+        if self.template_stride == 0 {
+            return Err(bad("template_stride", 0.0, "must be >= 1"));
+        }
+        if let Some(c) = self.coarse_to_fine
+            && (c.stride == 0 || c.keep == 0)
+        {
+            return Err(bad("coarse_to_fine", 0.0, "stride and keep must be >= 1"));
+        }
+        if self.icp_candidates == 0 {
+            return Err(bad("icp_candidates", 0.0, "must be >= 1"));
+        }
+        if self.min_points < 3 {
+            return Err(bad("min_points", self.min_points as f64, "must be >= 3"));
+        }
+        if !(self.model_spacing_m.is_finite() && self.model_spacing_m > 0.0) {
+            return Err(bad(
+                "model_spacing_m",
+                self.model_spacing_m,
+                "must be finite and > 0",
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_bad_values_refused() {
+        TemplateMatchingConfig::default().validate().unwrap();
+        let bads = [
+            TemplateMatchingConfig {
+                tau: f64::NAN,
+                ..Default::default()
+            },
+            TemplateMatchingConfig {
+                delta_deg: 0.0,
+                ..Default::default()
+            },
+            TemplateMatchingConfig {
+                f_max_m2: -1.0,
+                ..Default::default()
+            },
+            TemplateMatchingConfig {
+                icp_stages_m: vec![f64::INFINITY],
+                ..Default::default()
+            },
+            TemplateMatchingConfig {
+                min_points: 2,
+                ..Default::default()
+            },
+        ];
+        for c in bads {
+            assert!(c.validate().is_err(), "{c:?}");
+        }
+    }
+}

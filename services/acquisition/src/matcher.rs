@@ -1,0 +1,333 @@
+//! The on-line template matcher of seed 002 §2 (Fig. 2) with ICP
+//! refinement and the f_CONV failure check of §4.5 (Fig. 10).
+
+use crate::config::{TemplateMatchingConfig, Threads};
+use crate::correlation::{Centering, Correlator, d_bor, d_bor_passes};
+use crate::error::AcquisitionError;
+use crate::grid::euler_grid;
+use crate::outcome::AcquisitionOutcome;
+use crate::refine::{Refined, refine};
+use crate::template::TemplateRenderer;
+use nalgebra::{Rotation3, Vector3};
+use rayon::prelude::*;
+use spacepose_geometry::{Euler321, Point, Pose};
+use spacepose_lidar_sim::{LidarSimulator, SensorConfig};
+use spacepose_registration::IcpModel;
+use spacepose_target::Target;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Seed of the model-cloud sampling (any fixed value: the cloud is deterministic).
+const MODEL_SEED: u64 = 0x5eed_0002;
+
+/// How one template fared.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Score {
+    /// Fewer than 3 points (the target out of the field of view).
+    Empty,
+    /// Rejected by Eq. (3).
+    Rejected,
+    /// C of Eq. (1) and the template's centre (sensor frame).
+    Scored(f64, Vector3<f64>),
+}
+
+/// Per-acquisition inputs shared by every template evaluation.
+struct Sensed<'a> {
+    correlator: &'a Correlator,
+    centre: Vector3<f64>,
+    d_bor: f64,
+}
+
+/// The template matcher for one target and one sensor: attitude grid,
+/// template renderers and ICP model are built once here.
+#[derive(Debug)]
+pub struct TemplateMatcher {
+    target: Arc<Target>,
+    sensor: SensorConfig,
+    config: TemplateMatchingConfig,
+    grid: Vec<(Euler321, Rotation3<f64>)>,
+    renderer: TemplateRenderer,
+    coarse_renderer: Option<TemplateRenderer>,
+    icp_model: IcpModel,
+}
+
+impl TemplateMatcher {
+    /// Validates the configuration and the sensor, builds the Euler grid,
+    /// the template renderers and the ICP model (a surface sample of the
+    /// mesh at `model_spacing_m` with its lookup grid, ~1 s).
+    pub fn new(
+        target: Arc<Target>,
+        sensor: SensorConfig,
+        config: TemplateMatchingConfig,
+    ) -> Result<Self, AcquisitionError> {
+        config.validate()?;
+        // The simulator's own validation of the sensor and the materials.
+        LidarSimulator::new(target.clone(), sensor.clone())?;
+        let grid = euler_grid(config.delta_deg)?
+            .into_iter()
+            .map(|e| (e, e.to_rotation()))
+            .collect();
+        let renderer = TemplateRenderer::new(target.clone(), &sensor, config.template_stride);
+        let coarse_renderer = config
+            .coarse_to_fine
+            .map(|c| TemplateRenderer::new(target.clone(), &sensor, c.stride));
+        let model = target.sample_surface(config.model_spacing_m, MODEL_SEED);
+        let icp_model = IcpModel::new(&model)?;
+        Ok(Self {
+            target,
+            sensor,
+            config,
+            grid,
+            renderer,
+            coarse_renderer,
+            icp_model,
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &TemplateMatchingConfig {
+        &self.config
+    }
+
+    /// The sensor the templates are rendered for.
+    pub fn sensor(&self) -> &SensorConfig {
+        &self.sensor
+    }
+
+    /// The target.
+    pub fn target(&self) -> &Arc<Target> {
+        &self.target
+    }
+
+    /// Number of grid attitudes (templates per full pass).
+    pub fn grid_len(&self) -> usize {
+        self.grid.len()
+    }
+
+    /// Rays per full-resolution template.
+    pub fn template_rays(&self) -> usize {
+        self.renderer.rays()
+    }
+
+    /// Sets f_MAX (m²), e.g. after `spacepose calibrate fconv`.
+    pub fn set_f_max_m2(&mut self, f_max_m2: f64) -> Result<(), AcquisitionError> {
+        let config = TemplateMatchingConfig {
+            f_max_m2,
+            ..self.config.clone()
+        };
+        config.validate()?;
+        self.config = config;
+        Ok(())
+    }
+
+    /// Acquires the pose of the target in `cloud` (one frame, sensor
+    /// frame): template matching, ICP refinement of the best candidates,
+    /// f_CONV check. Non-finite points are ignored.
+    ///
+    /// Errors: [`AcquisitionError::TooFewPoints`] for a cloud with fewer
+    /// than `min_points` finite points (sparse or all-NaN: never a pose);
+    /// [`AcquisitionError::NoTemplate`] when no template could be
+    /// correlated. A failed refinement is not an error: the outcome is then
+    /// not accepted.
+    pub fn acquire(&self, cloud: &[Point]) -> Result<AcquisitionOutcome, AcquisitionError> {
+        let start = Instant::now();
+        let finite: Vec<Point> = cloud.iter().copied().filter(Point::is_finite).collect();
+        if finite.len() < self.config.min_points {
+            return Err(AcquisitionError::TooFewPoints {
+                valid: finite.len(),
+                total: cloud.len(),
+                required: self.config.min_points,
+            });
+        }
+        let positions: Vec<Vector3<f64>> = finite.iter().map(Point::position).collect();
+        let centering = if self.config.trimmed_centroid {
+            Centering::Trimmed(self.config.trim)
+        } else {
+            Centering::Mean
+        };
+        let mut scratch = Vec::new();
+        let centre =
+            centering
+                .centre(&positions, &mut scratch)
+                .ok_or(AcquisitionError::TooFewPoints {
+                    valid: 0,
+                    total: cloud.len(),
+                    required: self.config.min_points,
+                })?;
+        let correlator = Correlator::new(
+            &positions,
+            &centre,
+            centering,
+            self.config.max_correlation_points,
+        );
+        let sensed = Sensed {
+            correlator: &correlator,
+            centre,
+            d_bor: d_bor(&positions),
+        };
+        let (ranked, generated, rejected) = self.match_templates(&sensed);
+        let evaluated = ranked.len();
+        let Some(&(_, best_c, _)) = ranked.first() else {
+            return Err(AcquisitionError::NoTemplate {
+                generated,
+                rejected,
+            });
+        };
+        let matching_ms = ms_since(start);
+
+        // Template solution(s): grid attitude, origin from the centroid alignment.
+        let candidates: Vec<(usize, Pose)> = ranked
+            .iter()
+            .take(self.config.icp_candidates)
+            .map(|&(k, _, template_centre)| {
+                let t = centre + (centre - template_centre);
+                (k, Pose::new(self.grid[k].1, t))
+            })
+            .collect();
+        let refine_start = Instant::now();
+        let refined: Vec<Result<Refined, String>> = candidates
+            .iter()
+            .map(|(_, pose)| {
+                refine(&self.icp_model, &finite, pose, &self.config).map_err(|e| e.to_string())
+            })
+            .collect();
+        let refinement_ms = ms_since(refine_start);
+        let best = refined
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| r.as_ref().ok().map(|r| (i, r)))
+            .min_by(|a, b| a.1.f_conv_m2.total_cmp(&b.1.f_conv_m2));
+        let coarse_of = |rank: usize| candidates[rank].1;
+        let (chosen_rank, pose, f_conv, iterations, converged, inliers, refinement_error) =
+            match best {
+                Some((i, r)) => (
+                    i,
+                    r.t_sensor_target,
+                    r.f_conv_m2,
+                    r.iterations,
+                    r.converged,
+                    r.inlier_fraction,
+                    None,
+                ),
+                None => (
+                    0,
+                    coarse_of(0),
+                    f64::INFINITY,
+                    0,
+                    false,
+                    0.0,
+                    refined.first().and_then(|r| r.as_ref().err().cloned()),
+                ),
+            };
+        let f_conv_ok = f_conv.is_finite() && f_conv <= self.config.f_max_m2;
+        let chosen_k = candidates[chosen_rank].0;
+        Ok(AcquisitionOutcome {
+            t_sensor_target: pose,
+            t_sensor_target_coarse: coarse_of(chosen_rank),
+            euler_coarse: self.grid[chosen_k].0,
+            centroid_m: [centre.x, centre.y, centre.z],
+            correlation_m2: if chosen_rank == 0 {
+                best_c
+            } else {
+                ranked[chosen_rank].1
+            },
+            f_conv_m2: f_conv,
+            accepted: f_conv_ok,
+            templates_generated: generated,
+            templates_evaluated: evaluated,
+            templates_rejected: rejected,
+            points_used: finite.len(),
+            time_ms: ms_since(start),
+            matching_ms,
+            refinement_ms,
+            candidates_refined: candidates.len(),
+            chosen_rank,
+            icp_iterations: iterations,
+            icp_converged: converged,
+            icp_inlier_fraction: inliers,
+            refinement_error,
+        })
+    }
+
+    /// Renders and scores the templates: `(grid index, C, template centre)`
+    /// sorted by C, templates generated, templates rejected by Eq. (3).
+    fn match_templates(&self, sensed: &Sensed) -> (Vec<(usize, f64, Vector3<f64>)>, usize, usize) {
+        let all: Vec<usize> = (0..self.grid.len()).collect();
+        let (first, fine) = match (&self.coarse_renderer, self.config.coarse_to_fine) {
+            (Some(coarse), Some(c)) => (coarse, Some(c.keep)),
+            _ => (&self.renderer, None),
+        };
+        let scores = self.score(&all, first, sensed, self.config.fast);
+        let mut generated = scores.len();
+        let rejected = scores.iter().filter(|s| s.1 == Score::Rejected).count();
+        let mut ranked = rank(&scores);
+        if let Some(keep) = fine {
+            let kept: Vec<usize> = ranked.iter().take(keep).map(|r| r.0).collect();
+            // Eq. (3) was applied on the coarse pass.
+            let scores = self.score(&kept, &self.renderer, sensed, false);
+            generated += scores.len();
+            ranked = rank(&scores);
+        }
+        (ranked, generated, rejected)
+    }
+
+    /// Scores the grid attitudes `indices` with `renderer`.
+    fn score(
+        &self,
+        indices: &[usize],
+        renderer: &TemplateRenderer,
+        sensed: &Sensed,
+        fast: bool,
+    ) -> Vec<(usize, Score)> {
+        let one = |k: usize, template: &mut Vec<Vector3<f64>>, scratch: &mut Vec<f64>| {
+            renderer.render_into(&self.grid[k].1, &sensed.centre, template);
+            if template.len() < 3 {
+                return (k, Score::Empty);
+            }
+            if fast && !d_bor_passes(sensed.d_bor, d_bor(template), self.config.tau) {
+                return (k, Score::Rejected);
+            }
+            match sensed.correlator.correlation(template, scratch) {
+                Some((c, centre)) => (k, Score::Scored(c, centre)),
+                None => (k, Score::Empty),
+            }
+        };
+        match self.config.threads {
+            Threads::Single => {
+                let (mut template, mut scratch) = (Vec::new(), Vec::new());
+                indices
+                    .iter()
+                    .map(|&k| one(k, &mut template, &mut scratch))
+                    .collect()
+            }
+            Threads::All => indices
+                .par_iter()
+                .map_init(
+                    || (Vec::new(), Vec::new()),
+                    |(template, scratch), &k| one(k, template, scratch),
+                )
+                .collect(),
+        }
+    }
+}
+
+/// The scored templates sorted by C (ties by grid index).
+fn rank(scores: &[(usize, Score)]) -> Vec<(usize, f64, Vector3<f64>)> {
+    let mut ranked: Vec<(usize, f64, Vector3<f64>)> = scores
+        .iter()
+        .filter_map(|&(k, s)| match s {
+            Score::Scored(c, centre) => Some((k, c, centre)),
+            _ => None,
+        })
+        .collect();
+    ranked.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+    ranked
+}
+
+fn ms_since(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+#[cfg(test)]
+#[path = "matcher_tests.rs"]
+mod tests;

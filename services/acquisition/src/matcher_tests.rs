@@ -1,0 +1,170 @@
+use super::*;
+use crate::template::TemplateRenderer;
+use spacepose_geometry::so3;
+use spacepose_lidar_sim::Effects;
+use spacepose_scenario::TruthState;
+use std::sync::OnceLock;
+
+fn envisat() -> Arc<Target> {
+    Arc::new(Target::builtin("envisat").unwrap())
+}
+
+/// One matcher for every test (the ICP model takes about a second).
+fn matcher() -> &'static TemplateMatcher {
+    static M: OnceLock<TemplateMatcher> = OnceLock::new();
+    M.get_or_init(|| {
+        TemplateMatcher::new(
+            envisat(),
+            SensorConfig::raster_seed002(),
+            TemplateMatchingConfig::default(),
+        )
+        .unwrap()
+    })
+}
+
+fn frame(pose: Pose, effects: Effects, seed: u64) -> Vec<Point> {
+    let mut sensor = SensorConfig::raster_seed002();
+    sensor.effects = effects;
+    let sim = LidarSimulator::new(envisat(), sensor).unwrap();
+    let truth = TruthState {
+        t: 1.0,
+        t_sensor_target: pose,
+        v_sensor_target: Vector3::zeros(),
+        w_target: Vector3::zeros(),
+    };
+    sim.simulate(&truth, &mut LidarSimulator::frame_rng(seed, 0))
+        .points
+}
+
+#[test]
+fn noise_free_envisat_at_20_m_is_recovered_after_icp() {
+    let m = matcher();
+    assert_eq!(m.grid_len(), 605);
+    // Off the grid by 10-20 degrees on each angle.
+    let r = Euler321::from_degrees(40.0, 15.0, -110.0).to_rotation();
+    let truth = Pose::new(r, Vector3::new(0.2, -0.3, 20.0));
+    let cloud = frame(truth, Effects::none(), 1);
+    assert!(cloud.len() > 300, "{}", cloud.len());
+    let out = m.acquire(&cloud).unwrap();
+    let err_deg = so3::distance(&out.t_sensor_target.rotation, &r).to_degrees();
+    let err_m = (out.t_sensor_target.translation - truth.translation).norm();
+    assert!(
+        err_deg < 3.0 && err_m < 0.2,
+        "{err_deg} deg {err_m} m {out:?}"
+    );
+    assert!(out.accepted && out.f_conv_m2 < 1e-3, "{}", out.f_conv_m2);
+    assert_eq!(out.templates_generated, 605);
+    assert_eq!(out.templates_evaluated + out.templates_rejected, 605);
+    let coarse_deg = so3::distance(&out.t_sensor_target_coarse.rotation, &r).to_degrees();
+    assert!(coarse_deg < 45.0, "{coarse_deg}");
+}
+
+#[test]
+fn sparse_and_all_nan_clouds_are_errors() {
+    let m = matcher();
+    let r = Euler321::from_degrees(10.0, 0.0, 0.0).to_rotation();
+    let cloud = frame(
+        Pose::new(r, Vector3::new(0.0, 0.0, 20.0)),
+        Effects::none(),
+        2,
+    );
+    let sparse = &cloud[..19];
+    assert!(matches!(
+        m.acquire(sparse),
+        Err(AcquisitionError::TooFewPoints { valid: 19, .. })
+    ));
+    let nan: Vec<Point> = cloud
+        .iter()
+        .map(|p| Point::new(f32::NAN, p.y, p.z, p.intensity, p.t))
+        .collect();
+    assert!(matches!(
+        m.acquire(&nan),
+        Err(AcquisitionError::TooFewPoints { valid: 0, .. })
+    ));
+    assert!(matches!(
+        m.acquire(&[]),
+        Err(AcquisitionError::TooFewPoints { valid: 0, .. })
+    ));
+}
+
+#[test]
+fn random_outliers_are_never_accepted() {
+    use rand::{RngExt, SeedableRng};
+    let m = matcher();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let cloud: Vec<Point> = (0..300)
+        .map(|_| {
+            Point::new(
+                rng.random_range(-6.0..6.0),
+                rng.random_range(-6.0..6.0),
+                rng.random_range(15.0..25.0),
+                1.0,
+                0.0,
+            )
+        })
+        .collect();
+    match m.acquire(&cloud) {
+        Ok(out) => assert!(!out.accepted, "{}", out.f_conv_m2),
+        Err(e) => assert!(matches!(e, AcquisitionError::NoTemplate { .. }), "{e}"),
+    }
+}
+
+#[test]
+fn d_bor_rejects_a_clearly_wrong_template() {
+    let renderer = TemplateRenderer::new(envisat(), &SensorConfig::raster_seed002(), 1);
+    let t = Vector3::new(0.0, 0.0, 40.0);
+    // Broadside (long axis across the boresight) versus end-on (along it).
+    let broadside = renderer.render(&Rotation3::identity(), &t);
+    let end_on = renderer.render(
+        &Euler321::from_degrees(0.0, 90.0 - 1e-6, 0.0).to_rotation(),
+        &t,
+    );
+    let (d_s, d_wrong) = (d_bor(&broadside), d_bor(&end_on));
+    assert!(d_bor_passes(d_s, d_bor(&broadside), 0.1));
+    assert!(!d_bor_passes(d_s, d_wrong, 0.1), "{d_s} {d_wrong}");
+}
+
+#[test]
+fn single_thread_and_parallel_agree() {
+    let m = matcher();
+    let single = TemplateMatcher {
+        target: m.target.clone(),
+        sensor: m.sensor.clone(),
+        config: TemplateMatchingConfig {
+            threads: Threads::Single,
+            fast: true,
+            ..m.config.clone()
+        },
+        grid: m.grid.clone(),
+        renderer: m.renderer.clone(),
+        coarse_renderer: None,
+        icp_model: IcpModel::new(&m.target.sample_surface(0.3, 1)).unwrap(),
+    };
+    let r = Euler321::from_degrees(-70.0, -20.0, 50.0).to_rotation();
+    let cloud = frame(
+        Pose::new(r, Vector3::new(0.0, 0.0, 30.0)),
+        Effects::default(),
+        3,
+    );
+    let corr = {
+        let p: Vec<Vector3<f64>> = cloud.iter().map(Point::position).collect();
+        let c = spacepose_geometry::centroid(&p).unwrap();
+        (Correlator::new(&p, &c, Centering::Mean, 0), c, d_bor(&p))
+    };
+    let sensed = Sensed {
+        correlator: &corr.0,
+        centre: corr.1,
+        d_bor: corr.2,
+    };
+    let a = single.match_templates(&sensed);
+    let fast_all = TemplateMatcher {
+        config: TemplateMatchingConfig {
+            threads: Threads::All,
+            ..single.config.clone()
+        },
+        ..single
+    };
+    let b = fast_all.match_templates(&sensed);
+    assert_eq!(a, b);
+    assert!(a.2 > 0 && a.0.len() + a.2 == 605);
+}
