@@ -130,3 +130,6 @@ pub(crate) fn check_name(field: &str, name: &crate::Name) -> Result<(), CodecErr
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod fuzz_tests;

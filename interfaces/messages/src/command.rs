@@ -1,6 +1,7 @@
 //! Commands from the ground or the CLI: reinit, mode, swap.
 
 use crate::codec::{CodecError, WireMessage, check_code, check_name, fixed_max_wire_bytes};
+use crate::convert::QUATERNION_NORM_TOLERANCE;
 use crate::error::MessageError;
 use crate::pose::WireMode;
 use crate::{Name, SCHEMA_VERSION};
@@ -92,10 +93,26 @@ impl WireMessage for Command {
         self.schema
     }
 
+    /// Commands come from outside (the ground): besides the codes and names,
+    /// a re-initialisation pose must be finite and its quaternion of unit
+    /// norm (within [`QUATERNION_NORM_TOLERANCE`]); all zero = no pose.
     fn validate(&self) -> Result<(), CodecError> {
         check_code("kind", self.kind, CommandKind::Swap as u8)?;
         check_code("mode", self.mode, WireMode::MAX_CODE)?;
         check_name("target_instance", &self.target_instance)?;
-        check_name("issued_by", &self.issued_by)
+        check_name("issued_by", &self.issued_by)?;
+        let q = &self.q_sensor_target;
+        if !q.iter().chain(&self.p_sensor_target).all(|v| v.is_finite()) {
+            return Err(CodecError::Invalid(
+                "non-finite re-initialisation pose".to_string(),
+            ));
+        }
+        let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if self.has_pose() && (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
+            return Err(CodecError::Invalid(format!(
+                "re-initialisation quaternion of norm {norm} (expected 1)"
+            )));
+        }
+        Ok(())
     }
 }

@@ -28,4 +28,6 @@ pub use stats::IngestStats;
 #[cfg(test)]
 mod clutter_tests;
 #[cfg(test)]
+mod fuzz_tests;
+#[cfg(test)]
 mod stage_tests;

@@ -5,7 +5,7 @@ use rand_chacha::ChaCha8Rng;
 use spacepose_geometry::Point;
 use std::fmt::Debug;
 
-fn rng() -> ChaCha8Rng {
+pub(super) fn rng() -> ChaCha8Rng {
     ChaCha8Rng::seed_from_u64(0x5eed_c0dec)
 }
 
@@ -17,11 +17,17 @@ fn arr<const N: usize>(rng: &mut impl Rng) -> [f64; N] {
     std::array::from_fn(|_| f(rng))
 }
 
+fn unit_quaternion(rng: &mut impl Rng) -> [f64; 4] {
+    let q: [f64; 4] = arr(rng);
+    let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+    q.map(|v| v / n)
+}
+
 fn cov(rng: &mut impl Rng) -> [[f64; 6]; 6] {
     std::array::from_fn(|_| arr(rng))
 }
 
-fn pose_estimate(rng: &mut impl Rng) -> PoseEstimate {
+pub(super) fn pose_estimate(rng: &mut impl Rng) -> PoseEstimate {
     PoseEstimate {
         schema: SCHEMA_VERSION,
         status: rng.random_range(0..3),
@@ -44,7 +50,7 @@ fn pose_estimate(rng: &mut impl Rng) -> PoseEstimate {
     }
 }
 
-fn filter_state(rng: &mut impl Rng) -> FilterState {
+pub(super) fn filter_state(rng: &mut impl Rng) -> FilterState {
     FilterState {
         schema: SCHEMA_VERSION,
         initialized: 1,
@@ -60,7 +66,7 @@ fn filter_state(rng: &mut impl Rng) -> FilterState {
     }
 }
 
-fn acquisition(rng: &mut impl Rng) -> AcquisitionResult {
+pub(super) fn acquisition(rng: &mut impl Rng) -> AcquisitionResult {
     AcquisitionResult {
         schema: SCHEMA_VERSION,
         method: rng.random_range(0..3),
@@ -75,7 +81,7 @@ fn acquisition(rng: &mut impl Rng) -> AcquisitionResult {
     }
 }
 
-fn truth(rng: &mut impl Rng) -> TruthMsg {
+pub(super) fn truth(rng: &mut impl Rng) -> TruthMsg {
     TruthMsg {
         schema: SCHEMA_VERSION,
         sequence: rng.random(),
@@ -87,7 +93,7 @@ fn truth(rng: &mut impl Rng) -> TruthMsg {
     }
 }
 
-fn health(rng: &mut impl Rng) -> Health {
+pub(super) fn health(rng: &mut impl Rng) -> Health {
     Health {
         state: rng.random_range(0..4),
         sequence: rng.random(),
@@ -109,18 +115,18 @@ fn health(rng: &mut impl Rng) -> Health {
     }
 }
 
-fn command(rng: &mut impl Rng) -> Command {
+pub(super) fn command(rng: &mut impl Rng) -> Command {
     Command {
         mode: rng.random_range(0..4),
         sequence: rng.random(),
         target_instance: Name::new("tracker-a").unwrap(),
-        q_sensor_target: arr(rng),
+        q_sensor_target: unit_quaternion(rng),
         p_sensor_target: arr(rng),
         ..Command::new(CommandKind::Swap, Name::new("ground").unwrap())
     }
 }
 
-fn cloud(rng: &mut impl Rng, n: usize) -> CloudMsg {
+pub(super) fn cloud(rng: &mut impl Rng, n: usize) -> CloudMsg {
     let points = (0..n)
         .map(|_| {
             Point::new(
