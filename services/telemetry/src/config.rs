@@ -2,6 +2,7 @@
 
 use crate::error::TelemetryError;
 use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
 
 /// How the telemetry process joins zenoh: peer mode, explicit endpoints,
 /// multicast scouting off (the bus's `ZenohConfig` is built from this).
@@ -55,6 +56,28 @@ impl Default for Rates {
     }
 }
 
+/// Access control of the ground link (`[access]`): usrpwd authentication of
+/// every connecting peer and an ACL by username, default deny. The binary
+/// turns it into the bus's `AccessControl` (policy and reasons documented
+/// there and in `deploy/SECURITY.md`). Absent = no authentication: keep the
+/// default loopback endpoints then.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AccessConfig {
+    /// zenoh's usrpwd dictionary, one `user:password` per line (keep it
+    /// readable by the service's user only).
+    pub dictionary_file: PathBuf,
+    /// Accounts allowed to send commands (swap, reinit, mode) and read telemetry.
+    pub operators: Vec<String>,
+    /// Accounts allowed to read telemetry only.
+    #[serde(default)]
+    pub readers: Vec<String>,
+    /// Accounts of other hosts of the same suite (full access to the
+    /// deployment's keys).
+    #[serde(default)]
+    pub peers: Vec<String>,
+}
+
 /// The telemetry service's TOML file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -65,6 +88,9 @@ pub struct TelemetryConfig {
     pub rates: Rates,
     /// Frames kept to match estimates with truth by sequence.
     pub match_window: usize,
+    /// Who may read telemetry and send commands (absent = anyone who
+    /// reaches the endpoints).
+    pub access: Option<AccessConfig>,
 }
 
 impl Default for TelemetryConfig {
@@ -73,6 +99,7 @@ impl Default for TelemetryConfig {
             zenoh: ZenohEndpoints::default(),
             rates: Rates::default(),
             match_window: 64,
+            access: None,
         }
     }
 }
@@ -105,6 +132,11 @@ impl TelemetryConfig {
         if self.zenoh.listen.is_empty() && self.zenoh.connect.is_empty() {
             return bad("zenoh needs at least one listen or connect endpoint".into());
         }
+        if let Some(a) = &self.access
+            && a.operators.is_empty()
+        {
+            return bad("access.operators is empty: nobody could send commands".into());
+        }
         Ok(())
     }
 }
@@ -129,5 +161,29 @@ mod tests {
         let mut c = TelemetryConfig::default();
         c.zenoh.listen.clear();
         assert!(c.validate().is_err());
+    }
+
+    #[test]
+    fn access_control_is_optional_and_strict() {
+        assert_eq!(TelemetryConfig::default().access, None);
+        let c: TelemetryConfig = toml::from_str(
+            "[access]\ndictionary_file = \"/etc/sp/users\"\noperators = [\"op\"]\nreaders = [\"ground\"]\n",
+        )
+        .unwrap();
+        c.validate().unwrap();
+        let a = c.access.unwrap();
+        assert_eq!(
+            (a.operators, a.readers, a.peers.len()),
+            (vec!["op".to_string()], vec!["ground".to_string()], 0)
+        );
+        let c: TelemetryConfig =
+            toml::from_str("[access]\ndictionary_file = \"u\"\noperators = []\n").unwrap();
+        assert!(c.validate().unwrap_err().to_string().contains("operators"));
+        assert!(
+            toml::from_str::<TelemetryConfig>(
+                "[access]\ndictionary_file = \"u\"\noperators = []\nwriters = []\n"
+            )
+            .is_err()
+        );
     }
 }

@@ -16,7 +16,7 @@ pub mod hub;
 pub mod latest;
 pub mod rate;
 
-pub use config::{Rates, TelemetryConfig, ZenohEndpoints};
+pub use config::{AccessConfig, Rates, TelemetryConfig, ZenohEndpoints};
 pub use error::TelemetryError;
 pub use hub::{Output, TelemetryHub};
 pub use latest::{FrameStats, LATEST_KEY, TelemetryLatest};

@@ -9,6 +9,15 @@
 //! postcard `Command`s from `spacepose/{prefix}/wire/command` to the
 //! iceoryx2 command topic; payloads the codec refuses are counted in this
 //! service's `rejected_wire` health counter.
+//!
+//! Security: with an `[access]` table the zenoh session requires a usrpwd
+//! account from every connecting peer and enforces an ACL by username
+//! (readers: telemetry only; operators: telemetry and commands; default
+//! deny), so only operators' commands ever reach the bridge. Without it,
+//! anyone who reaches the endpoints may command the suite: the endpoints are
+//! loopback by default, and listening elsewhere without `[access]` is
+//! warned about. Why usernames (not TLS certificates, interfaces or zenoh
+//! ids): `spacepose_bus::zenoh_access` and `deploy/SECURITY.md`.
 
 use anyhow::Context;
 use clap::Parser;
@@ -16,7 +25,8 @@ use serde::Deserialize;
 use spacepose_bus::zenoh::Wait;
 use spacepose_bus::zenoh::bytes::Encoding;
 use spacepose_bus::{
-    Bridge, Bus, Msg, Route, Subscriber, WakeReason, ZenohConfig, open_zenoh, zenoh,
+    AccessControl, Bridge, Bus, Msg, Route, Subscriber, WakeReason, ZenohConfig, open_zenoh_with,
+    zenoh,
 };
 use spacepose_messages::{FilterState, Health, Names, PoseEstimate, ServiceState, Topic, TruthMsg};
 use spacepose_service_kit::{
@@ -24,7 +34,7 @@ use spacepose_service_kit::{
 };
 use spacepose_telemetry::hub::Stream;
 use spacepose_telemetry::{
-    LATEST_KEY, Output, RateLimiter, TelemetryConfig, TelemetryError, TelemetryHub,
+    AccessConfig, LATEST_KEY, Output, RateLimiter, TelemetryConfig, TelemetryError, TelemetryHub,
 };
 use std::collections::HashMap;
 use std::process::ExitCode;
@@ -41,8 +51,51 @@ struct Config(TelemetryConfig);
 
 impl ServiceConfig for Config {
     fn validate(&self) -> Result<(), String> {
-        self.0.validate().map_err(|e| e.to_string())
+        self.0.validate().map_err(|e| e.to_string())?;
+        // The accounts and the dictionary are checked too (`--check`).
+        match &self.0.access {
+            Some(a) => access_control(a).validate().map_err(|e| e.to_string()),
+            None => Ok(()),
+        }
     }
+}
+
+fn access_control(a: &AccessConfig) -> AccessControl {
+    AccessControl {
+        dictionary_file: a.dictionary_file.clone(),
+        operators: a.operators.clone(),
+        readers: a.readers.clone(),
+        peers: a.peers.clone(),
+    }
+}
+
+/// Opens the ground-link session, with the access control if configured.
+fn open_ground_session(config: &TelemetryConfig, names: &Names) -> anyhow::Result<zenoh::Session> {
+    let zenoh = zenoh_config(config);
+    let access = config.access.as_ref().map(access_control);
+    match &access {
+        Some(a) => tracing::info!(
+            operators = ?a.operators,
+            readers = ?a.readers,
+            peers = ?a.peers,
+            "zenoh access control on: usrpwd accounts, ACL by username, default deny"
+        ),
+        None => {
+            let exposed = zenoh.non_loopback_listen();
+            if !exposed.is_empty() {
+                tracing::warn!(
+                    ?exposed,
+                    "listening beyond loopback WITHOUT access control: anyone who reaches \
+                     these endpoints can read telemetry and send commands (add [access])"
+                );
+            }
+        }
+    }
+    open_zenoh_with(&zenoh, |c| match &access {
+        Some(a) => a.apply(names, c),
+        None => Ok(()),
+    })
+    .context("opening zenoh")
 }
 
 fn main() -> ExitCode {
@@ -129,7 +182,7 @@ fn run(args: ServiceArgs) -> anyhow::Result<()> {
     let names = Names::new(&args.prefix).context("deployment prefix")?;
     let instance = args.instance_or(SERVICE);
     let shutdown = shutdown_flag();
-    let session = open_zenoh(&zenoh_config(&config)).context("opening zenoh")?;
+    let session = open_ground_session(&config, &names)?;
     let mut hub = TelemetryHub::new(names.prefix(), config.match_window);
     let latest = Arc::new(Mutex::new(hub.latest_json()?));
     let _queryable = declare_latest(&session, &names, Arc::clone(&latest))?;
