@@ -15,7 +15,7 @@ use spacepose_messages::{
     AcquisitionMethod, AcquisitionResult, CloudHeader, MAX_POINTS, Name, Names, ServiceState,
     TruthMsg,
 };
-use spacepose_scenario::{Scenario, ScenarioConfig, ScenarioKind, TruthState};
+use spacepose_scenario::{LookAway, Scenario, ScenarioConfig, ScenarioKind, TruthState};
 use spacepose_service_kit::{
     Counters, HealthReporter, ServiceArgs, ServiceConfig, init_logging, load_config, shutdown_flag,
 };
@@ -59,6 +59,10 @@ struct Config {
     exit_at_end: bool,
     /// Sensor id written in the cloud headers.
     sensor_id: u16,
+    /// Frames during which the sensor looks away from the target (e.g.
+    /// `look_away = { first_frame = 8, frames = 4, angle_deg = 60.0 }`): the
+    /// loss-and-reacquisition variant. Absent = never.
+    look_away: Option<LookAway>,
 }
 
 impl Default for Config {
@@ -77,6 +81,7 @@ impl Default for Config {
             truth_init: false,
             exit_at_end: false,
             sensor_id: 0,
+            look_away: None,
         }
     }
 }
@@ -93,6 +98,9 @@ impl ServiceConfig for Config {
         positive("scale", self.scale)?;
         positive("range_m", self.range_m)?;
         positive("integration_time_s", self.integration_time_s)?;
+        if let Some(look) = &self.look_away {
+            look.validate().map_err(|e| e.to_string())?;
+        }
         if !(self.compression.is_finite() && self.compression >= 1.0) {
             return Err(format!(
                 "compression must be >= 1, got {}",
@@ -139,6 +147,7 @@ impl Source {
         sc.compression = config.compression;
         sc.range_m = config.range_m;
         sc.random_frames = sc.random_frames.max(config.frames as usize);
+        sc.look_away = config.look_away;
         let scenario = spacepose_scenario::build(&sc).context("invalid scenario")?;
         let mut sensor = SensorConfig::livox_mid40();
         sensor.integration_time_s = config.integration_time_s;

@@ -349,3 +349,32 @@ fn invalid_configuration_is_rejected() {
     };
     assert!(LidarSimulator::new(deos(), config).is_err());
 }
+
+#[test]
+fn frames_looking_away_see_no_target_and_the_others_do() {
+    use spacepose_scenario::{LookAway, ScenarioConfig, ScenarioKind};
+    let look = LookAway::frames(2, 3);
+    let scenario = spacepose_scenario::build(&ScenarioConfig {
+        seed: 7,
+        look_away: Some(look),
+        ..ScenarioConfig::default_for(ScenarioKind::Tumbling)
+    })
+    .unwrap();
+    let s = sim(Effects::default());
+    let mut counts = Vec::new();
+    for (k, t) in scenario.frame_end_times(7).into_iter().enumerate() {
+        let frame = s.simulate(
+            &scenario.state_at(t),
+            &mut LidarSimulator::frame_rng(7, k as u64),
+        );
+        counts.push(frame.points.len());
+    }
+    println!("points per frame, frames 2-4 looking away: {counts:?}");
+    for (k, n) in counts.iter().enumerate() {
+        if look.covers_frame(k) {
+            assert_eq!(*n, 0, "frame {k}");
+        } else {
+            assert!(*n > 1000, "frame {k}: {n} points");
+        }
+    }
+}

@@ -1,6 +1,7 @@
 //! Scenario selection and parameters.
 
 use crate::error::ScenarioError;
+use crate::look_away::LookAway;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
@@ -88,6 +89,10 @@ pub struct ScenarioConfig {
     pub lateral_offset_deg: f64,
     /// Random scenario: number of independent frames (seed 002: 500 per range).
     pub random_frames: usize,
+    /// Frames during which the sensor looks away from the target (the
+    /// loss-and-reacquisition variant); `None` (default) = never.
+    #[serde(default)]
+    pub look_away: Option<LookAway>,
 }
 
 impl Default for ScenarioConfig {
@@ -114,11 +119,12 @@ impl ScenarioConfig {
             pointing_error_deg: 0.3,
             lateral_offset_deg: 1.0,
             random_frames: 500,
+            look_away: None,
         }
     }
 
-    /// Rejects NaN/non-positive periods and ranges, compression below 1 and
-    /// out-of-bounds error amplitudes.
+    /// Rejects NaN/non-positive periods and ranges, compression below 1,
+    /// out-of-bounds error amplitudes and an invalid look-away window.
     pub fn validate(&self) -> Result<(), ScenarioError> {
         if !(self.frame_period_s.is_finite() && self.frame_period_s > 0.0) {
             return Err(ScenarioError::InvalidFramePeriod(self.frame_period_s));
@@ -139,6 +145,9 @@ impl ScenarioConfig {
         }
         if self.kind == ScenarioKind::Random && self.random_frames == 0 {
             return Err(ScenarioError::NoFrames);
+        }
+        if let Some(look) = &self.look_away {
+            look.validate()?;
         }
         Ok(())
     }

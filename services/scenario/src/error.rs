@@ -26,4 +26,7 @@ pub enum ScenarioError {
     /// The random scenario was asked for no frame at all.
     #[error("the random scenario needs at least one frame")]
     NoFrames,
+    /// The look-away window is empty or its angle is not in (0, 180] degrees.
+    #[error("invalid look-away window: {0}")]
+    InvalidLookAway(String),
 }

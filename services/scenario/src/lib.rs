@@ -31,6 +31,9 @@
 //!   (LVLH rotates at n); 241 frames at 50 s.
 //! - random: range exactly `range_m`, centre of mass off the boresight by up
 //!   to ±1° per axis; yaw, pitch, roll uniform in the open intervals.
+//! - look-away variant (any scenario, `ScenarioConfig::look_away`): the
+//!   sensor turns 60° (default) about its `x` axis for whole frames, so they
+//!   see no target; the truth stays exact (issue 5's reacquisition case).
 //! - pointing error: 0.3° per axis, sinusoids with seeded periods in
 //!   [90, 180] s (true clock), at most 0.42° off the boresight.
 //!
@@ -48,6 +51,7 @@ pub mod attitude;
 pub mod chaser;
 pub mod config;
 pub mod error;
+pub mod look_away;
 pub mod pointing;
 pub mod presets;
 pub mod profile;
@@ -58,6 +62,7 @@ pub mod truth;
 
 pub use config::{ScenarioConfig, ScenarioKind};
 pub use error::ScenarioError;
+pub use look_away::{LookAway, LookingAway};
 pub use random::random_frame_euler;
 pub use scenario::Scenario;
 pub use truth::TruthState;
@@ -65,7 +70,7 @@ pub use truth::TruthState;
 /// Builds the scenario a (validated) configuration describes.
 pub fn build(config: &ScenarioConfig) -> Result<Box<dyn Scenario>, ScenarioError> {
     config.validate()?;
-    Ok(match config.kind {
+    let scenario: Box<dyn Scenario> = match config.kind {
         ScenarioKind::SlowSpin => Box::new(presets::slow_spin(config)),
         ScenarioKind::Tumbling => Box::new(presets::tumbling(config)),
         ScenarioKind::Ellipse => Box::new(presets::ellipse(config)),
@@ -76,6 +81,10 @@ pub fn build(config: &ScenarioConfig) -> Result<Box<dyn Scenario>, ScenarioError
             range_m: config.range_m,
             lateral_offset_rad: config.lateral_offset_deg.to_radians(),
         }),
+    };
+    Ok(match &config.look_away {
+        Some(look) => Box::new(LookingAway::new(scenario, look)?),
+        None => scenario,
     })
 }
 
