@@ -177,6 +177,10 @@ def train(args: argparse.Namespace) -> int:
     log(f"val floor of the argmax monitor (argmax of the true soft label vs truth, d_sym): "
         f"mean {oracle.mean():.2f} deg, max {oracle.max():.2f} deg")
 
+    lab = np.asarray(va.labels)
+    entropy = -(lab * np.log(np.clip(lab, 1e-12, 1.0))).sum(axis=1).mean()
+    log(f"floor of the attitude loss (mean entropy of the val soft labels): {entropy:.3f}; "
+        f"uniform prediction: {math.log(m):.3f}")
     net = PoseNet(m, side, width_mult=args.width, dropout=args.dropout).to(memory_format=CL)
     log(f"model: MobileNetV3-Small width {args.width}, 1-channel stem, input {n}x{n}, "
         f"{count_parameters(net)} parameters, channels_last")
