@@ -11,7 +11,7 @@
 //!   (Eq. 12).
 //! - [`wire`]: conversions to and from the suite's messages (`FilterState`,
 //!   `PoseEstimate`, `AcquisitionResult`); [`selector`]: one estimate per
-//!   frame; [`service`]: the logic of the `spacepose-filter` binary, bus-free.
+//!   frame (primary/standby with a per-frame deadline); [`service`]: the logic of the `spacepose-filter` binary, bus-free.
 //!
 //! Units SI. `R = r_sensor_target` (target body → sensor), `p = p_sensor` the
 //! target origin in the sensor frame, `v_sensor = dp/dt` in the sensor frame,
@@ -35,5 +35,5 @@ pub use error::FilterError;
 pub use filter::{Prediction, RelativeMotionFilter, UpdateOutcome, covariance_from_information};
 pub use motion_compensation::MotionCompensation;
 pub use position::PositionFilter;
-pub use selector::{EstimateSelector, Selection};
-pub use service::{EstimateOutcome, FilterNode, FilterServiceConfig};
+pub use selector::{Candidate, Choice, FrameSelector, Offer, Quality, Reason};
+pub use service::{EstimateOutcome, FilterNode, FilterServiceConfig, Fusion};

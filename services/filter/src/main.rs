@@ -1,16 +1,22 @@
 //! `spacepose-filter`: the authority on the relative motion.
 //!
-//! Subscribes to the trackers' `PoseEstimate`s and to `AcquisitionResult`s,
-//! initialises on an accepted acquisition, fuses one `tracking` estimate per
-//! frame and publishes the `FilterState` after every change and every
-//! `state_period_ms` (heartbeat for late joiners). Logic: [`FilterNode`].
+//! Subscribes to the trackers' `PoseEstimate`s, to `AcquisitionResult`s and
+//! to commands, initialises on an accepted acquisition, fuses one estimate
+//! per frame (the primary tracker's, or a standby's when the primary's is
+//! missing at the frame deadline, late or unusable) and publishes the
+//! `FilterState` after every change and every `state_period_ms` (heartbeat
+//! for late joiners). A `swap` command names the new primary (applied at
+//! the next undecided frame). Logic: [`FilterNode`].
 
 use anyhow::Context;
 use clap::Parser;
 use serde::Deserialize;
 use spacepose_bus::{Bus, Publisher, Subscriber, WakeReason};
-use spacepose_filter::{FilterError, FilterNode, FilterServiceConfig};
-use spacepose_messages::{AcquisitionResult, FilterState, Names, PoseEstimate, ServiceState};
+use spacepose_filter::{FilterError, FilterNode, FilterServiceConfig, Fusion, Reason};
+use spacepose_messages::{
+    AcquisitionResult, Command, CommandKind, FilterState, Names, PoseEstimate, ServiceState,
+    realtime_ns,
+};
 use spacepose_service_kit::{
     Counters, HealthReporter, ServiceArgs, ServiceConfig, init_logging, load_config, shutdown_flag,
 };
@@ -45,6 +51,7 @@ fn main() -> ExitCode {
 struct Ports {
     estimates: Subscriber<PoseEstimate>,
     acquisitions: Subscriber<AcquisitionResult>,
+    commands: Subscriber<Command>,
     states: Publisher<FilterState>,
 }
 
@@ -58,6 +65,7 @@ fn run(args: ServiceArgs) -> anyhow::Result<()> {
     let ports = Ports {
         estimates: bus.subscriber(&names.pose())?,
         acquisitions: bus.subscriber(&names.acquisition())?,
+        commands: bus.subscriber(&names.command())?,
         states: bus.publisher(&names.filter_state())?,
     };
     let heartbeat = Duration::from_millis(args.heartbeat_ms.max(1));
@@ -65,19 +73,27 @@ fn run(args: ServiceArgs) -> anyhow::Result<()> {
     let mut waiter = bus.waitset()?;
     waiter.attach(&ports.estimates)?;
     waiter.attach(&ports.acquisitions)?;
+    waiter.attach(&ports.commands)?;
     let mut node = FilterNode::new(&config)?;
     let mut counters = Counters::default();
     let state_period =
         (config.state_period_ms > 0).then(|| Duration::from_millis(config.state_period_ms));
     let mut last_state = Instant::now();
-    tracing::info!(prefix = names.prefix(), instance, "filter service running");
+    tracing::info!(prefix = names.prefix(), instance, primary = ?node.primary(), "filter service running");
     while !shutdown.load(Ordering::Relaxed) {
-        let timeout = state_period.map_or(heartbeat, |p| p.min(heartbeat));
+        let mut timeout = state_period.map_or(heartbeat, |p| p.min(heartbeat));
+        if let Some(deadline_ns) = node.next_deadline_ns() {
+            let left_ns = deadline_ns.saturating_sub(realtime_ns()).max(0) as u64;
+            // Wake just after the deadline, not before it.
+            timeout = timeout.min(Duration::from_nanos(left_ns) + Duration::from_micros(200));
+        }
         if waiter.wait(timeout)? == WakeReason::TerminationRequested {
             break;
         }
-        let mut changed = drain_acquisitions(&ports, &mut node, &mut counters);
+        let mut changed = drain_commands(&ports, &mut node, &mut counters);
+        changed |= drain_acquisitions(&ports, &mut node, &mut counters);
         changed |= drain_estimates(&ports, &mut node, &mut counters);
+        changed |= report(node.poll(realtime_ns()), &mut counters);
         if changed || state_period.is_some_and(|p| last_state.elapsed() >= p) {
             publish(&ports, &node, &mut counters);
             last_state = Instant::now();
@@ -135,6 +151,66 @@ fn drain_acquisitions(ports: &Ports, node: &mut FilterNode, counters: &mut Count
     }
 }
 
+/// Applies swap commands (the target instance becomes the primary); other
+/// commands are for the trackers. Returns whether a fusion changed the state.
+fn drain_commands(ports: &Ports, node: &mut FilterNode, counters: &mut Counters) -> bool {
+    let mut changed = false;
+    loop {
+        let c = match ports.commands.try_recv() {
+            Ok(Some(c)) => c,
+            Ok(None) => return changed,
+            Err(e) => {
+                counters.errors += 1;
+                tracing::warn!("receiving a command: {e}");
+                return changed;
+            }
+        };
+        match CommandKind::from_u8(c.kind) {
+            Ok(CommandKind::Swap) if !c.target_instance.is_empty() => {
+                let new = c.target_instance.as_str().to_string();
+                tracing::info!(
+                    issued_by = %c.issued_by,
+                    old = ?node.primary(),
+                    new,
+                    "swap: new primary from the next frame"
+                );
+                changed |= report(node.set_primary(&new), counters);
+            }
+            Ok(CommandKind::Swap) => {
+                counters.rejected_wire += 1;
+                tracing::warn!(issued_by = %c.issued_by, "swap command without a target instance refused");
+            }
+            Ok(_) => {}
+            Err(e) => {
+                counters.rejected_wire += 1;
+                tracing::warn!("command refused: {e}");
+            }
+        }
+    }
+}
+
+/// Logs the selector's decisions; returns whether one changed the state.
+fn report(fusions: Vec<Fusion>, counters: &mut Counters) -> bool {
+    let mut changed = false;
+    for f in fusions {
+        changed |= f.changed_state();
+        if !matches!(f.reason, Reason::Primary | Reason::FirstArrival) {
+            tracing::info!(sequence = f.sequence, instance = f.instance, reason = ?f.reason, "standby estimate taken");
+        }
+        match &f.outcome {
+            Ok(o) if !o.changed_state() => {
+                tracing::debug!(sequence = f.sequence, outcome = ?o, "estimate not fused");
+            }
+            Ok(_) => {}
+            Err(err) => {
+                counters.errors += 1;
+                tracing::warn!(sequence = f.sequence, "filter update failed: {err}");
+            }
+        }
+    }
+    changed
+}
+
 /// Returns whether an estimate changed the state.
 fn drain_estimates(ports: &Ports, node: &mut FilterNode, counters: &mut Counters) -> bool {
     let mut changed = false;
@@ -150,13 +226,8 @@ fn drain_estimates(ports: &Ports, node: &mut FilterNode, counters: &mut Counters
         };
         counters.frames_in += 1;
         counters.last_frame = e.sequence;
-        match node.on_estimate(&e) {
-            Ok(outcome) => {
-                changed |= outcome.changed_state();
-                if !outcome.changed_state() {
-                    tracing::debug!(sequence = e.sequence, ?outcome, "estimate not fused");
-                }
-            }
+        match node.on_estimate(&e, realtime_ns()) {
+            Ok((_, fusions)) => changed |= report(fusions, counters),
             Err(err @ FilterError::InvalidMessage { .. }) => {
                 counters.rejected_non_finite += 1;
                 tracing::warn!(sequence = e.sequence, "estimate refused: {err}");

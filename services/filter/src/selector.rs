@@ -1,112 +1,334 @@
-//! One estimate per frame: with redundant trackers (issue 7) several
-//! `PoseEstimate`s arrive for the same cloud sequence; the filter must fuse
-//! only one of them. The rule for now is "first arrival wins".
+//! One estimate per frame (issue 7): with redundant trackers several
+//! `PoseEstimate`s arrive for the same cloud sequence, and exactly one of
+//! them may reach the filter's fusion.
+//!
+//! - Without a primary (a single tracker, or roles not configured) the rule
+//!   is "first arrival wins".
+//! - With a primary (`primary = "tracker-a"` in the filter's config) the
+//!   primary's estimate is taken, unless it is **missing** (nothing by the
+//!   frame's deadline), **late** (after the deadline, when a standby's was
+//!   already taken) or **unusable** (not `tracking`, or inconsistent with the
+//!   filter's prediction); then the best standby estimate is taken. Every
+//!   other instance is a standby.
+//!
+//! The frame's deadline is `cloud_published_ns + deadline`: both trackers
+//! work on the same cloud, so they carry the same publish time. Decisions are
+//! emitted in frame order: deciding frame `k` first decides every older
+//! frame still waiting, with what it has.
+//!
+//! The selector is generic over the payload (the filter uses
+//! `PoseEstimate`), pure, and driven by the caller's clock (`now_ns`).
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 
-/// What the selector decided for an estimate.
+/// How usable an estimate is for fusion (judged by the caller).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Quality {
+    /// `tracking` and consistent with the prediction.
+    Good,
+    /// `tracking`, but too far from the filter's prediction.
+    Inconsistent,
+    /// `degraded` or `lost`.
+    NotTracking,
+}
+
+/// One estimate offered to the selector.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Candidate<T> {
+    /// Instance that produced it (e.g. `"tracker-a"`).
+    pub instance: String,
+    /// Frame (cloud) sequence.
+    pub sequence: u64,
+    /// When the frame's cloud was published (ns, CLOCK_REALTIME); 0 when
+    /// unknown (the deadline then runs from the first arrival).
+    pub cloud_published_ns: i64,
+    /// Usability.
+    pub quality: Quality,
+    /// The estimate.
+    pub payload: T,
+}
+
+/// Why an estimate was chosen for its frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Selection {
-    /// The first estimate of its sequence: use it.
-    Selected,
-    /// Another estimate of this sequence was selected before: drop it.
+pub enum Reason {
+    /// No primary configured: the first estimate of the frame.
+    FirstArrival,
+    /// The primary's, on time and usable.
+    Primary,
+    /// The primary's, after the deadline, no standby estimate being there.
+    PrimaryLate,
+    /// A standby's: the primary sent nothing by the deadline.
+    PrimaryMissing,
+    /// A standby's: the primary's estimate was unusable.
+    PrimaryUnusable(Quality),
+    /// Nothing usable by the deadline (or a newer frame was decided): the
+    /// best of what arrived (the primary's if any).
+    Fallback,
+}
+
+/// A decision: the estimate of a frame to fuse.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Choice<T> {
+    /// The chosen estimate.
+    pub candidate: Candidate<T>,
+    /// Why it was chosen.
+    pub reason: Reason,
+}
+
+/// What happened to an offered estimate, besides the decisions emitted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Offer {
+    /// It was chosen (it is in the returned decisions).
+    Chosen,
+    /// Kept until the primary's estimate or the deadline (decided in the
+    /// same call when that deadline has already passed).
+    Held,
+    /// Not chosen: a better estimate of its frame was (a standby's instead
+    /// of an unusable primary's).
+    Superseded,
+    /// Its frame was already decided (a second tracker, or a late primary).
     Duplicate,
-    /// Older than the remembered window (a straggler): drop it.
+    /// Older than the remembered window (a straggler).
     Stale,
 }
 
-/// Remembers the sequences already selected within a sliding window.
-///
-/// A sequence more than `window` behind the newest one is `Stale`, except
-/// when it is so far behind (more than `2 × window`) that the source has
-/// evidently restarted its numbering: the selector then forgets everything
-/// and selects it.
 #[derive(Debug, Clone)]
-pub struct EstimateSelector {
-    window: u64,
-    seen: BTreeSet<u64>,
+struct Pending<T> {
+    deadline_ns: i64,
+    primary: Option<Candidate<T>>,
+    /// The best standby estimate so far (first arrival among equals).
+    standby: Option<Candidate<T>>,
 }
 
-impl EstimateSelector {
-    /// A selector remembering `window` sequences (at least 1).
-    pub fn new(window: usize) -> Self {
+/// The primary/standby rule over a sliding window of frames.
+///
+/// A sequence more than `window` behind the newest decided one is `Stale`,
+/// except when it is so far behind (more than `2 × window`) that the source
+/// has evidently restarted its numbering: the selector then forgets
+/// everything and takes it.
+#[derive(Debug, Clone)]
+pub struct FrameSelector<T> {
+    primary: Option<String>,
+    deadline_ns: i64,
+    window: u64,
+    decided: BTreeSet<u64>,
+    pending: BTreeMap<u64, Pending<T>>,
+}
+
+impl<T: Clone> FrameSelector<T> {
+    /// A selector with `primary` (none = first arrival wins), a per-frame
+    /// deadline (ms after the cloud's publication) and a window of
+    /// `window` frames (at least 1).
+    pub fn new(primary: Option<String>, deadline_ms: f64, window: usize) -> Self {
         Self {
+            primary,
+            deadline_ns: (deadline_ms.max(0.0) * 1e6) as i64,
             window: window.max(1) as u64,
-            seen: BTreeSet::new(),
+            decided: BTreeSet::new(),
+            pending: BTreeMap::new(),
         }
     }
 
-    /// The newest sequence selected so far.
-    pub fn newest(&self) -> Option<u64> {
-        self.seen.last().copied()
+    /// The primary instance, if roles are configured.
+    pub fn primary(&self) -> Option<&str> {
+        self.primary.as_deref()
     }
 
-    /// Decides for an estimate of frame `sequence`.
-    pub fn offer(&mut self, sequence: u64) -> Selection {
-        if let Some(newest) = self.newest() {
-            let behind = newest.saturating_sub(sequence);
-            if behind > 2 * self.window {
-                self.seen.clear();
-            } else if behind > self.window {
-                return Selection::Stale;
+    /// Makes `instance` the primary from the next undecided frame on (a
+    /// frame boundary: frames already decided stay decided). Held estimates
+    /// change role with it; a good one of the new primary is decided now.
+    pub fn set_primary(&mut self, instance: &str) -> Vec<Choice<T>> {
+        self.primary = Some(instance.to_string());
+        let mut ready = Vec::new();
+        for (seq, p) in &mut self.pending {
+            let mut all: Vec<Candidate<T>> = p.primary.take().into_iter().collect();
+            all.extend(p.standby.take());
+            for c in all {
+                if c.instance == instance {
+                    p.primary = Some(c);
+                } else {
+                    p.standby = better_standby(p.standby.take(), c);
+                }
+            }
+            if p.primary
+                .as_ref()
+                .is_some_and(|c| c.quality == Quality::Good)
+            {
+                ready.push(*seq);
             }
         }
-        if !self.seen.insert(sequence) {
-            return Selection::Duplicate;
+        let mut out = Vec::new();
+        for seq in ready {
+            if let Some(c) = self.pending.remove(&seq).and_then(|p| p.primary) {
+                out.extend(self.decide(c, Reason::Primary));
+            }
+        }
+        out
+    }
+
+    /// The newest decided frame.
+    pub fn newest(&self) -> Option<u64> {
+        self.decided.last().copied()
+    }
+
+    /// The earliest deadline of a frame still waiting (ns), to wake up for.
+    pub fn next_deadline_ns(&self) -> Option<i64> {
+        self.pending.values().map(|p| p.deadline_ns).min()
+    }
+
+    /// Offers an estimate at time `now_ns`; returns what happened to it and
+    /// the decisions made (in frame order, possibly for older frames too).
+    pub fn offer(&mut self, c: Candidate<T>, now_ns: i64) -> (Offer, Vec<Choice<T>>) {
+        if self.decided.contains(&c.sequence) {
+            return (Offer::Duplicate, Vec::new());
         }
         if let Some(newest) = self.newest() {
-            let oldest_kept = newest.saturating_sub(self.window);
-            self.seen = self.seen.split_off(&oldest_kept);
+            let behind = newest.saturating_sub(c.sequence);
+            if behind > 2 * self.window {
+                self.reset();
+            } else if behind > self.window {
+                return (Offer::Stale, Vec::new());
+            }
         }
-        Selection::Selected
+        let Some(primary) = self.primary.clone() else {
+            return (Offer::Chosen, self.decide(c, Reason::FirstArrival));
+        };
+        let base = if c.cloud_published_ns > 0 {
+            c.cloud_published_ns
+        } else {
+            now_ns
+        };
+        let deadline_ns = base.saturating_add(self.deadline_ns);
+        let late = now_ns > deadline_ns;
+        let seq = c.sequence;
+        let pending = self.pending.entry(seq).or_insert(Pending {
+            deadline_ns,
+            primary: None,
+            standby: None,
+        });
+        if c.instance == primary {
+            if c.quality == Quality::Good {
+                let reason = if late {
+                    Reason::PrimaryLate
+                } else {
+                    Reason::Primary
+                };
+                self.pending.remove(&seq);
+                return (Offer::Chosen, self.decide(c, reason));
+            }
+            if let Some(s) = pending.standby.take_if(|s| s.quality == Quality::Good) {
+                let reason = Reason::PrimaryUnusable(c.quality);
+                self.pending.remove(&seq);
+                return (Offer::Superseded, self.decide(s, reason));
+            }
+            pending.primary = Some(c);
+        } else {
+            let primary_bad = pending
+                .primary
+                .as_ref()
+                .map(|p| p.quality)
+                .filter(|q| *q != Quality::Good);
+            if c.quality == Quality::Good
+                && let Some(q) = primary_bad
+            {
+                self.pending.remove(&seq);
+                return (Offer::Chosen, self.decide(c, Reason::PrimaryUnusable(q)));
+            }
+            if late && c.quality == Quality::Good {
+                self.pending.remove(&seq);
+                return (Offer::Chosen, self.decide(c, Reason::PrimaryMissing));
+            }
+            pending.standby = better_standby(pending.standby.take(), c);
+        }
+        (Offer::Held, self.expire(now_ns))
+    }
+
+    /// Decides every frame whose deadline has passed at `now_ns`.
+    pub fn poll(&mut self, now_ns: i64) -> Vec<Choice<T>> {
+        self.expire(now_ns)
+    }
+
+    fn expire(&mut self, now_ns: i64) -> Vec<Choice<T>> {
+        let due: Vec<u64> = self
+            .pending
+            .iter()
+            .filter(|(_, p)| p.deadline_ns < now_ns)
+            .map(|(s, _)| *s)
+            .collect();
+        let mut out = Vec::new();
+        for seq in due {
+            if let Some(p) = self.pending.remove(&seq)
+                && let Some((c, reason)) = fallback(p)
+            {
+                out.extend(self.decide(c, reason));
+            }
+        }
+        out
+    }
+
+    /// Records `c` as its frame's decision, after deciding every older
+    /// waiting frame (frame order is kept).
+    fn decide(&mut self, c: Candidate<T>, reason: Reason) -> Vec<Choice<T>> {
+        let older: Vec<u64> = self.pending.range(..c.sequence).map(|(s, _)| *s).collect();
+        let mut out = Vec::new();
+        for seq in older {
+            if let Some(p) = self.pending.remove(&seq)
+                && let Some((old, why)) = fallback(p)
+            {
+                self.mark(old.sequence);
+                out.push(Choice {
+                    candidate: old,
+                    reason: why,
+                });
+            }
+        }
+        self.mark(c.sequence);
+        out.push(Choice {
+            candidate: c,
+            reason,
+        });
+        out
+    }
+
+    fn mark(&mut self, sequence: u64) {
+        self.decided.insert(sequence);
+        if let Some(newest) = self.newest() {
+            let oldest_kept = newest.saturating_sub(self.window);
+            self.decided = self.decided.split_off(&oldest_kept);
+        }
     }
 
     /// Forgets everything (e.g. after a re-initialisation).
     pub fn reset(&mut self) {
-        self.seen.clear();
+        self.decided.clear();
+        self.pending.clear();
+    }
+}
+
+/// The better of two standby estimates: a good one beats an unusable one;
+/// among equals the first stays.
+fn better_standby<T>(old: Option<Candidate<T>>, new: Candidate<T>) -> Option<Candidate<T>> {
+    match old {
+        Some(o) if o.quality <= new.quality => Some(o),
+        _ => Some(new),
+    }
+}
+
+/// The decision for a frame at its deadline: a good standby, else the
+/// primary's (whatever its quality), else the standby's.
+fn fallback<T>(p: Pending<T>) -> Option<(Candidate<T>, Reason)> {
+    match (p.primary, p.standby) {
+        (None, Some(s)) if s.quality == Quality::Good => Some((s, Reason::PrimaryMissing)),
+        (Some(pr), Some(s)) if s.quality == Quality::Good => {
+            let q = pr.quality;
+            Some((s, Reason::PrimaryUnusable(q)))
+        }
+        (Some(pr), _) => Some((pr, Reason::Fallback)),
+        (None, Some(s)) => Some((s, Reason::Fallback)),
+        (None, None) => None,
     }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn first_arrival_wins_per_sequence() {
-        let mut s = EstimateSelector::new(8);
-        assert_eq!(s.offer(5), Selection::Selected);
-        assert_eq!(s.offer(5), Selection::Duplicate);
-        assert_eq!(s.offer(6), Selection::Selected);
-        // Out of order but inside the window: still the first of its frame.
-        assert_eq!(s.offer(4), Selection::Selected);
-        assert_eq!(s.offer(4), Selection::Duplicate);
-        assert_eq!(s.offer(6), Selection::Duplicate);
-        assert_eq!(s.newest(), Some(6));
-    }
-
-    #[test]
-    fn the_window_bounds_memory_and_drops_stragglers() {
-        let mut s = EstimateSelector::new(4);
-        for k in 0..100 {
-            assert_eq!(s.offer(k), Selection::Selected);
-            assert_eq!(s.offer(k), Selection::Duplicate);
-        }
-        assert!(s.seen.len() <= 5, "{}", s.seen.len());
-        assert_eq!(s.offer(94), Selection::Stale);
-        assert_eq!(s.offer(96), Selection::Duplicate);
-    }
-
-    #[test]
-    fn a_restarted_source_is_followed() {
-        let mut s = EstimateSelector::new(4);
-        for k in 1000..1010 {
-            s.offer(k);
-        }
-        assert_eq!(s.offer(0), Selection::Selected);
-        assert_eq!(s.newest(), Some(0));
-        assert_eq!(s.offer(1), Selection::Selected);
-        assert_eq!(s.offer(0), Selection::Duplicate);
-        s.reset();
-        assert_eq!(s.offer(0), Selection::Selected);
-    }
-}
+#[path = "selector_tests.rs"]
+mod tests;

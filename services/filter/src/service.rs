@@ -5,8 +5,8 @@
 use crate::config::FilterConfig;
 use crate::error::FilterError;
 use crate::filter::RelativeMotionFilter;
-use crate::selector::{EstimateSelector, Selection};
-use crate::wire::{acquisition_pose, measurement_from_estimate, state_of, zero_rates};
+use crate::selector::{Candidate, Choice, FrameSelector, Offer, Quality, Reason};
+use crate::wire::{Measurement, acquisition_pose, measurement_from_estimate, state_of, zero_rates};
 use serde::{Deserialize, Serialize};
 use spacepose_messages::{AcquisitionResult, FilterState, PoseEstimate, WireStatus};
 
@@ -25,6 +25,18 @@ pub struct FilterServiceConfig {
     pub state_period_ms: u64,
     /// Frames remembered by the one-estimate-per-frame selector.
     pub selector_window: usize,
+    /// The primary tracker instance of a redundant deployment (e.g.
+    /// `"tracker-a"`); every other instance is a standby. None: the first
+    /// estimate of each frame wins. A swap command changes it at run time.
+    pub primary: Option<String>,
+    /// Per-frame deadline (ms after the cloud's publication by ingest): a
+    /// primary estimate later than this is replaced by a standby's.
+    pub frame_deadline_ms: f64,
+    /// A `tracking` estimate further than this from the filter's
+    /// prediction (deg) is inconsistent: a standby's is preferred.
+    pub max_disagreement_deg: f64,
+    /// Same, on the position (m).
+    pub max_disagreement_m: f64,
 }
 
 impl Default for FilterServiceConfig {
@@ -36,6 +48,10 @@ impl Default for FilterServiceConfig {
             },
             state_period_ms: 500,
             selector_window: 64,
+            primary: None,
+            frame_deadline_ms: 100.0,
+            max_disagreement_deg: 10.0,
+            max_disagreement_m: 0.5,
         }
     }
 }
@@ -48,6 +64,25 @@ impl FilterServiceConfig {
             return Err(FilterError::InvalidConfig(
                 "selector_window must be >= 1".into(),
             ));
+        }
+        let positive = [
+            ("frame_deadline_ms", self.frame_deadline_ms),
+            ("max_disagreement_deg", self.max_disagreement_deg),
+            ("max_disagreement_m", self.max_disagreement_m),
+        ];
+        for (name, v) in positive {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(FilterError::InvalidConfig(format!(
+                    "{name} = {v} must be finite and > 0"
+                )));
+            }
+        }
+        if let Some(p) = &self.primary
+            && spacepose_messages::Name::new(p).is_err()
+        {
+            return Err(FilterError::InvalidConfig(format!(
+                "primary = {p:?} is not an instance name"
+            )));
         }
         Ok(())
     }
@@ -66,10 +101,6 @@ pub enum EstimateOutcome {
         /// Squared Mahalanobis distance of the innovation.
         mahalanobis2: f64,
     },
-    /// Another estimate of the same frame was selected first.
-    Duplicate,
-    /// Older than the selector's window.
-    Stale,
     /// Not a `tracking` estimate: reported, not fused (as in the tracker).
     NotTracking(WireStatus),
     /// The filter has not been initialised by an acquisition yet.
@@ -88,11 +119,33 @@ impl EstimateOutcome {
     }
 }
 
+/// An estimate the selector chose for its frame, and what fusing it did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fusion {
+    /// Frame sequence.
+    pub sequence: u64,
+    /// Instance that produced the estimate.
+    pub instance: String,
+    /// Why the selector chose it.
+    pub reason: Reason,
+    /// What the fusion did (an error leaves the state unchanged).
+    pub outcome: Result<EstimateOutcome, FilterError>,
+}
+
+impl Fusion {
+    /// True when the state changed and should be published.
+    pub fn changed_state(&self) -> bool {
+        self.outcome.as_ref().is_ok_and(|o| o.changed_state())
+    }
+}
+
 /// The filter service: the authoritative relative-motion state.
 #[derive(Debug, Clone)]
 pub struct FilterNode {
     filter: RelativeMotionFilter,
-    selector: EstimateSelector,
+    selector: FrameSelector<Measurement>,
+    max_disagreement_rad: f64,
+    max_disagreement_m: f64,
     updates: u64,
     /// Time of the last (re)initialisation while no estimate has been fused since.
     fresh_init_t: Option<f64>,
@@ -104,7 +157,13 @@ impl FilterNode {
         config.validate()?;
         Ok(Self {
             filter: RelativeMotionFilter::new(config.filter.clone())?,
-            selector: EstimateSelector::new(config.selector_window),
+            selector: FrameSelector::new(
+                config.primary.clone(),
+                config.frame_deadline_ms,
+                config.selector_window,
+            ),
+            max_disagreement_rad: config.max_disagreement_deg.to_radians(),
+            max_disagreement_m: config.max_disagreement_m,
             updates: 0,
             fresh_init_t: None,
         })
@@ -139,15 +198,89 @@ impl FilterNode {
         Ok(true)
     }
 
-    /// Selects, checks and fuses a tracker estimate. Errors on a bad message
-    /// or a filter failure (the state is then unchanged).
-    pub fn on_estimate(&mut self, e: &PoseEstimate) -> Result<EstimateOutcome, FilterError> {
+    /// The primary instance of the selector (None: first arrival wins).
+    pub fn primary(&self) -> Option<&str> {
+        self.selector.primary()
+    }
+
+    /// Makes `instance` the primary from the next undecided frame on (swap
+    /// command); returns the fusions this decides at once.
+    pub fn set_primary(&mut self, instance: &str) -> Vec<Fusion> {
+        let choices = self.selector.set_primary(instance);
+        self.fuse_all(choices)
+    }
+
+    /// The earliest frame deadline the node waits for (ns, CLOCK_REALTIME):
+    /// call [`Self::poll`] then.
+    pub fn next_deadline_ns(&self) -> Option<i64> {
+        self.selector.next_deadline_ns()
+    }
+
+    /// Offers a tracker estimate received at `now_ns` to the
+    /// one-estimate-per-frame selector and fuses what it decides (this
+    /// frame, or older ones waiting for their deadline). Errors on a bad
+    /// message (nothing is offered then).
+    pub fn on_estimate(
+        &mut self,
+        e: &PoseEstimate,
+        now_ns: i64,
+    ) -> Result<(Offer, Vec<Fusion>), FilterError> {
         let m = measurement_from_estimate(e)?;
-        match self.selector.offer(e.sequence) {
-            Selection::Selected => {}
-            Selection::Duplicate => return Ok(EstimateOutcome::Duplicate),
-            Selection::Stale => return Ok(EstimateOutcome::Stale),
+        let candidate = Candidate {
+            instance: e.instance.as_str().to_string(),
+            sequence: e.sequence,
+            cloud_published_ns: e.cloud_published_ns,
+            quality: self.quality(&m),
+            payload: m,
+        };
+        let (offer, choices) = self.selector.offer(candidate, now_ns);
+        Ok((offer, self.fuse_all(choices)))
+    }
+
+    /// Decides and fuses the frames whose deadline has passed.
+    pub fn poll(&mut self, now_ns: i64) -> Vec<Fusion> {
+        let choices = self.selector.poll(now_ns);
+        self.fuse_all(choices)
+    }
+
+    /// Usable for fusion: `tracking` and within the disagreement bounds of
+    /// the prediction (when there is one after the filter's time).
+    fn quality(&self, m: &Measurement) -> Quality {
+        if m.status != WireStatus::Tracking {
+            return Quality::NotTracking;
         }
+        let predicted = match self.filter.time() {
+            Some(t) if m.t > t => self.filter.predict_at(m.t).ok(),
+            _ => None,
+        };
+        match predicted {
+            Some(p) => {
+                let (angle_rad, dist_m) = m.t_sensor_target.error_to(&p.pose);
+                if angle_rad > self.max_disagreement_rad || dist_m > self.max_disagreement_m {
+                    Quality::Inconsistent
+                } else {
+                    Quality::Good
+                }
+            }
+            None => Quality::Good,
+        }
+    }
+
+    fn fuse_all(&mut self, choices: Vec<Choice<Measurement>>) -> Vec<Fusion> {
+        choices
+            .into_iter()
+            .map(|c| Fusion {
+                sequence: c.candidate.sequence,
+                instance: c.candidate.instance.clone(),
+                reason: c.reason,
+                outcome: self.fuse(&c.candidate.payload),
+            })
+            .collect()
+    }
+
+    /// Checks and fuses the estimate chosen for a frame. Errors on a filter
+    /// failure (the state is then unchanged).
+    fn fuse(&mut self, m: &Measurement) -> Result<EstimateOutcome, FilterError> {
         if m.status != WireStatus::Tracking {
             return Ok(EstimateOutcome::NotTracking(m.status));
         }
@@ -202,6 +335,22 @@ mod tests {
         e
     }
 
+    /// Offers `e` (first arrival wins: no primary) and returns the offer and
+    /// the outcome of its fusion, if it was chosen.
+    fn offer(
+        node: &mut FilterNode,
+        e: &PoseEstimate,
+    ) -> Result<(Offer, Option<EstimateOutcome>), FilterError> {
+        let (o, fusions) = node.on_estimate(e, 0)?;
+        assert!(fusions.len() <= 1);
+        let outcome = fusions.into_iter().next().map(|f| f.outcome).transpose()?;
+        Ok((o, outcome))
+    }
+
+    fn fused(node: &mut FilterNode, e: &PoseEstimate) -> EstimateOutcome {
+        offer(node, e).unwrap().1.unwrap()
+    }
+
     fn acquisition(t: f64) -> AcquisitionResult {
         let mut a = AcquisitionResult::new();
         a.success = 1;
@@ -215,18 +364,15 @@ mod tests {
         let mut node = FilterNode::new(&FilterServiceConfig::default()).unwrap();
         assert_eq!(node.state().initialized, 0);
         let e1 = estimate(1, 1.0, WireStatus::Tracking);
-        assert_eq!(
-            node.on_estimate(&e1).unwrap(),
-            EstimateOutcome::NotInitialized
-        );
+        assert_eq!(fused(&mut node, &e1), EstimateOutcome::NotInitialized);
         let mut failed = acquisition(0.0);
         failed.success = 0;
         assert!(!node.on_acquisition(&failed).unwrap());
         assert!(node.on_acquisition(&acquisition(0.0)).unwrap());
         for k in 1..6u64 {
             let e = estimate(k, k as f64, WireStatus::Tracking);
-            assert_eq!(node.on_estimate(&e).unwrap(), EstimateOutcome::Fused);
-            assert_eq!(node.on_estimate(&e).unwrap(), EstimateOutcome::Duplicate);
+            assert_eq!(fused(&mut node, &e), EstimateOutcome::Fused);
+            assert_eq!(offer(&mut node, &e).unwrap(), (Offer::Duplicate, None));
         }
         let s = node.state();
         assert_eq!((s.initialized, s.sequence, s.t_s), (1, 6, 5.0));
@@ -239,24 +385,20 @@ mod tests {
     fn degraded_lost_old_and_bad_estimates_change_nothing() {
         let mut node = FilterNode::new(&FilterServiceConfig::default()).unwrap();
         node.on_acquisition(&acquisition(0.0)).unwrap();
-        node.on_estimate(&estimate(1, 1.0, WireStatus::Tracking))
-            .unwrap();
+        fused(&mut node, &estimate(1, 1.0, WireStatus::Tracking));
         let before = node.state();
         for status in [WireStatus::Degraded, WireStatus::Lost] {
             let e = estimate(2 + status as u64, 2.0, status);
-            assert_eq!(
-                node.on_estimate(&e).unwrap(),
-                EstimateOutcome::NotTracking(status)
-            );
+            assert_eq!(fused(&mut node, &e), EstimateOutcome::NotTracking(status));
         }
         let old = estimate(9, 0.5, WireStatus::Tracking);
         assert!(matches!(
-            node.on_estimate(&old).unwrap(),
+            fused(&mut node, &old),
             EstimateOutcome::TooOld { .. }
         ));
         let mut bad = estimate(10, 3.0, WireStatus::Tracking);
         bad.p_sensor_target[0] = f64::NAN;
-        assert!(node.on_estimate(&bad).is_err());
+        assert!(node.on_estimate(&bad, 0).is_err());
         assert_eq!(node.state(), before);
     }
 
@@ -266,18 +408,93 @@ mod tests {
         node.on_acquisition(&acquisition(2.0)).unwrap();
         let mut e = estimate(2, 2.0, WireStatus::Tracking);
         e.p_sensor_target[2] += 0.05;
-        assert_eq!(
-            node.on_estimate(&e).unwrap(),
-            EstimateOutcome::Reinitialized
-        );
+        assert_eq!(fused(&mut node, &e), EstimateOutcome::Reinitialized);
         assert_eq!(node.state().p_sensor_target, e.p_sensor_target);
         let next = estimate(3, 3.0, WireStatus::Tracking);
-        assert_eq!(node.on_estimate(&next).unwrap(), EstimateOutcome::Fused);
+        assert_eq!(fused(&mut node, &next), EstimateOutcome::Fused);
         // After a fused update the same time is simply too old.
         let again = estimate(4, 3.0, WireStatus::Tracking);
         assert!(matches!(
-            node.on_estimate(&again).unwrap(),
+            fused(&mut node, &again),
             EstimateOutcome::TooOld { .. }
         ));
+    }
+
+    fn redundant_estimate(instance: &str, seq: u64, p: &Pose) -> PoseEstimate {
+        let mut e = estimate(seq, seq as f64, WireStatus::Tracking);
+        e.instance = spacepose_messages::Name::new(instance).unwrap();
+        e.cloud_published_ns = seq as i64 * 1_000_000_000;
+        e.set_pose(p);
+        e
+    }
+
+    #[test]
+    fn an_inconsistent_primary_gives_way_to_the_standby_and_a_swap_moves_the_role() {
+        let config = FilterServiceConfig {
+            primary: Some("tracker-a".into()),
+            ..FilterServiceConfig::default()
+        };
+        let mut node = FilterNode::new(&config).unwrap();
+        node.on_acquisition(&acquisition(0.0)).unwrap();
+        let ms = 1_000_000;
+        for k in 1..4u64 {
+            let t0 = k as i64 * 1_000_000_000;
+            let b = redundant_estimate("tracker-b", k, &pose_at(k as f64));
+            assert_eq!(node.on_estimate(&b, t0 + 5 * ms).unwrap().0, Offer::Held);
+            let a = redundant_estimate("tracker-a", k, &pose_at(k as f64));
+            let (o, f) = node.on_estimate(&a, t0 + 10 * ms).unwrap();
+            assert_eq!((o, f[0].instance.as_str()), (Offer::Chosen, "tracker-a"));
+            assert_eq!(f[0].outcome, Ok(EstimateOutcome::Fused));
+        }
+        // Frame 4: the primary is 20° off the prediction.
+        let t0 = 4_000_000_000;
+        let mut off = pose_at(4.0);
+        off.rotation = so3::exp(&Vector3::new(0.35, 0.0, 0.0)) * off.rotation;
+        let a = redundant_estimate("tracker-a", 4, &off);
+        assert_eq!(node.on_estimate(&a, t0 + 5 * ms).unwrap().0, Offer::Held);
+        let b = redundant_estimate("tracker-b", 4, &pose_at(4.0));
+        let (_, f) = node.on_estimate(&b, t0 + 10 * ms).unwrap();
+        assert_eq!(f[0].instance, "tracker-b");
+        assert_eq!(f[0].reason, Reason::PrimaryUnusable(Quality::Inconsistent));
+        assert!(f[0].changed_state());
+        // Frame 5: the primary is missing; the standby is fused at the deadline.
+        let t0 = 5_000_000_000;
+        let b = redundant_estimate("tracker-b", 5, &pose_at(5.0));
+        node.on_estimate(&b, t0 + 5 * ms).unwrap();
+        assert_eq!(node.next_deadline_ns(), Some(t0 + 100 * ms));
+        assert!(node.poll(t0 + 50 * ms).is_empty());
+        let f = node.poll(t0 + 101 * ms);
+        assert_eq!((f[0].sequence, f[0].reason), (5, Reason::PrimaryMissing));
+        assert_eq!(node.state().t_s, 5.0);
+        // A swap makes tracker-b the primary: frame 6 needs no deadline.
+        assert!(node.set_primary("tracker-b").is_empty());
+        assert_eq!(node.primary(), Some("tracker-b"));
+        let b = redundant_estimate("tracker-b", 6, &pose_at(6.0));
+        let (o, f) = node.on_estimate(&b, 6_000_000_000 + 5 * ms).unwrap();
+        assert_eq!((o, f[0].reason), (Offer::Chosen, Reason::Primary));
+    }
+
+    #[test]
+    fn selector_settings_are_validated() {
+        for bad in [
+            FilterServiceConfig {
+                frame_deadline_ms: 0.0,
+                ..FilterServiceConfig::default()
+            },
+            FilterServiceConfig {
+                max_disagreement_deg: f64::NAN,
+                ..FilterServiceConfig::default()
+            },
+            FilterServiceConfig {
+                primary: Some("no spaces allowed".into()),
+                ..FilterServiceConfig::default()
+            },
+        ] {
+            assert!(bad.validate().is_err(), "{bad:?}");
+        }
+        let c: FilterServiceConfig =
+            toml::from_str("primary = \"tracker-a\"\nframe_deadline_ms = 80.0\n").unwrap();
+        assert_eq!(c.primary.as_deref(), Some("tracker-a"));
+        c.validate().unwrap();
     }
 }
