@@ -87,6 +87,10 @@ pub struct TrackerNode {
     max_points: usize,
     pending: Option<PendingInit>,
     initialized: bool,
+    /// A fresh instance (started or restarted while the suite runs, or
+    /// swapped in) may start from the filter service's state; false once
+    /// initialised or told to wait for an acquisition.
+    warm_start: bool,
 }
 
 impl TrackerNode {
@@ -104,6 +108,7 @@ impl TrackerNode {
             max_points,
             pending: None,
             initialized: false,
+            warm_start: true,
         })
     }
 
@@ -129,13 +134,22 @@ impl TrackerNode {
     }
 
     /// Replaces the local filter with the filter service's state (ignored
-    /// before initialisation, while an initialisation is pending, and for
-    /// states older than the local one).
+    /// while an initialisation is pending, and for states older than the
+    /// local one). A fresh instance that was never initialised starts from
+    /// it (warm start of a restarted or swapped-in tracker, issue 7).
     pub fn on_filter_state(&mut self, s: &FilterState) -> Result<(), TrackError> {
         let prediction = prediction_from_state(s).map_err(|e| invalid("FilterState", e))?;
         match prediction {
             Some(p) if self.initialized && self.pending.is_none() => {
                 self.tracker.restore_filter(&p)
+            }
+            Some(p) if self.warm_start && self.pending.is_none() => {
+                self.tracker
+                    .initialize(p.t, &p.pose, p.v_sensor, p.w_target)?;
+                self.tracker.restore_filter(&p)?;
+                self.initialized = true;
+                self.warm_start = false;
+                Ok(())
             }
             _ => Ok(()),
         }
@@ -162,6 +176,7 @@ impl TrackerNode {
                 let config = self.tracker.config().clone();
                 self.tracker = Tracker::new(config, self.model.clone())?;
                 self.initialized = false;
+                self.warm_start = false;
                 self.pending = None;
                 Ok(CommandOutcome::ReinitFromAcquisition)
             }

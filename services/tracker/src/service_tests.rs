@@ -194,9 +194,21 @@ fn filter_states_are_followed_once_tracking() {
         )
         .unwrap();
     let state = spacepose_filter::wire::state_of(&filter, 1);
-    // Ignored before initialisation (nothing to follow yet).
+    // Told to wait for an acquisition: the state is not followed yet.
+    let ground = Name::new("ground").unwrap();
+    node.on_command(&Command::new(CommandKind::Reinit, ground))
+        .unwrap();
     node.on_filter_state(&state).unwrap();
     assert!(!node.is_tracking());
+    // A fresh instance (restarted or swapped in) warm-starts from the
+    // filter service's state and tracks the next frame.
+    let mut fresh = self::node();
+    fresh.on_filter_state(&state).unwrap();
+    assert!(fresh.is_tracking());
+    let r = fresh.on_cloud(&header(2, &f[2]), &f[2].points);
+    assert_eq!(status(&r), WireStatus::Tracking, "{}", r.reason);
+    let (ang, _) = errors(&r, &f[2]);
+    assert!(ang < 2.0, "warm-started frame error {ang} deg");
     node.on_acquisition(&truth_acquisition(&f[0])).unwrap();
     node.on_cloud(&header(1, &f[1]), &f[1].points);
     node.on_filter_state(&state).unwrap();
