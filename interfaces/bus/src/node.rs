@@ -19,6 +19,73 @@ pub struct Bus {
     node: Node<ipc::Service>,
     names: Names,
     cleaned_dead_nodes: usize,
+    // Declared after `node`: dropped after it (fields drop in order).
+    _last_node_cleanup: LastNodeCleanup,
+}
+
+/// Removes the deployment's leftover shared-memory files once the last
+/// node of its prefix has closed (see [`remove_deployment_files`]).
+struct LastNodeCleanup(Names);
+
+impl Drop for LastNodeCleanup {
+    fn drop(&mut self) {
+        match remove_deployment_files(&self.0) {
+            Ok(0) => {}
+            Ok(n) => tracing::debug!(
+                prefix = self.0.prefix(),
+                files = n,
+                "removed the deployment's shared-memory files"
+            ),
+            Err(e) => tracing::debug!(prefix = self.0.prefix(), "shared-memory cleanup: {e}"),
+        }
+    }
+}
+
+/// Where iceoryx2 keeps its shared-memory files on Linux.
+const SHM_DIR: &str = "/dev/shm";
+
+/// True for an iceoryx2 file of exactly this prefix (`{iox_prefix}{40 hex}_…`):
+/// prefix `a` must not match the files of prefix `a_b`.
+pub fn is_deployment_file(file_name: &str, iox_prefix: &str) -> bool {
+    file_name.strip_prefix(iox_prefix).is_some_and(|rest| {
+        rest.len() > 41
+            && rest.as_bytes()[..40].iter().all(u8::is_ascii_hexdigit)
+            && rest.as_bytes()[40] == b'_'
+    })
+}
+
+/// Removes the shared-memory files of the deployment `names` when no
+/// iceoryx2 node of its prefix is left (alive or dead); returns how many
+/// were removed (0 while a node exists).
+///
+/// iceoryx2 keeps one persistent file per prefix (`…_node.<version>.global_mgmt`,
+/// its node counter) after the last node is gone; with a fresh prefix per
+/// test or demo run they piled up in `/dev/shm`. Every [`Bus`] calls this
+/// when it closes.
+pub fn remove_deployment_files(names: &Names) -> Result<usize, BusError> {
+    let config = iceoryx2_config(names)?;
+    let mut nodes = 0usize;
+    Node::<ipc::Service>::list(&config, |_| {
+        nodes += 1;
+        CallbackProgression::Continue
+    })
+    .map_err(|e| BusError::Node(format!("listing nodes: {e:?}")))?;
+    if nodes > 0 {
+        return Ok(0);
+    }
+    let iox_prefix = names.iceoryx2_prefix();
+    let Ok(entries) = std::fs::read_dir(SHM_DIR) else {
+        return Ok(0);
+    };
+    Ok(entries
+        .flatten()
+        .filter(|e| {
+            e.file_name()
+                .to_str()
+                .is_some_and(|n| is_deployment_file(n, &iox_prefix))
+        })
+        .filter(|e| std::fs::remove_file(e.path()).is_ok())
+        .count())
 }
 
 impl std::fmt::Debug for Bus {
@@ -99,6 +166,7 @@ impl Bus {
             node,
             names: names.clone(),
             cleaned_dead_nodes,
+            _last_node_cleanup: LastNodeCleanup(names.clone()),
         })
     }
 
@@ -182,5 +250,49 @@ impl Bus {
             .max_nodes(EVENT_MAX_NODES)
             .open_or_create()
             .map_err(|e| BusError::service(service, e))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    fn files_of(names: &Names) -> Vec<String> {
+        std::fs::read_dir(SHM_DIR)
+            .unwrap()
+            .flatten()
+            .filter_map(|e| e.file_name().to_str().map(str::to_string))
+            .filter(|n| is_deployment_file(n, &names.iceoryx2_prefix()))
+            .collect()
+    }
+
+    #[test]
+    fn only_files_of_the_exact_prefix_match() {
+        let hash = "9204dd183d1c4d8e1ff592a30766ffa6765aa8b5";
+        let f = format!("sp_a_{hash}_node.0_10_0.global_mgmt");
+        assert!(is_deployment_file(&f, "sp_a_"));
+        let g = format!("sp_a_b_{hash}_node.global_mgmt");
+        assert!(!is_deployment_file(&g, "sp_a_"));
+        assert!(is_deployment_file(&g, "sp_a_b_"));
+        assert!(!is_deployment_file("sp_a_", "sp_a_"));
+    }
+
+    #[test]
+    fn the_last_node_to_close_leaves_no_shared_memory_behind() {
+        let prefix = format!("tshm{}", std::process::id());
+        let names = Names::new(&prefix).unwrap();
+        let a = Bus::open(&names, "a").unwrap();
+        let b = Bus::open(&names, "b").unwrap();
+        let _sub = a
+            .subscriber::<spacepose_messages::Health>(&names.health())
+            .unwrap();
+        assert!(!files_of(&names).is_empty());
+        drop(b);
+        // `a` is still open: its files stay.
+        assert!(!files_of(&names).is_empty());
+        drop(_sub);
+        drop(a);
+        assert_eq!(files_of(&names), Vec::<String>::new());
     }
 }
