@@ -6,6 +6,8 @@
 //! missing one fails the test with the command that builds it.
 #![forbid(unsafe_code)]
 
+pub mod net;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};

@@ -123,7 +123,7 @@ fn fuzz<T: WireMessage + Debug>(valid: &[Vec<u8>], extra_must_reject: &[Vec<u8>]
     let mut rng = rng();
     let mut oversized = vec![0u8; T::MAX_WIRE_BYTES + 16];
     let mut t = Tally::default();
-    let mut check = |bytes: &[u8], must: bool, t: &mut Tally| {
+    let check = |bytes: &[u8], must: bool, t: &mut Tally| {
         let r = decode::<T>(bytes);
         if let Ok(msg) = &r {
             // What the codec lets through is a valid message.
