@@ -14,17 +14,20 @@
 //! distinguishable from an empty pixel).
 //!
 //! # Choice of N (measured by `cargo bench -p spacepose-cnn --bench preprocess`)
-//! Preprocessing one simulated 10k-point `deos` frame at 10 m on one core
-//! (shared machine, median): N = 64: 0.11 ms, 96: 0.11 ms, 128: 0.12 ms,
-//! 224: 0.16 ms. The trimmed centroid (three O(n) selections) dominates; the
-//! image size only adds the zeroing and the per-pixel division, so
-//! preprocessing never decides N. The CNN does: training cost grows with N²
+//! Preprocessing one simulated 10,623-point `deos` frame at 10 m on one core,
+//! Criterion mean, measured while the machine ran the dataset generation
+//! (load ≈ 6 on 2 cores, so absolute values are inflated and noisy):
+//! N = 64: 0.77 ms, 96: 0.92 ms, 128: 0.81 ms, 224: 0.65 ms. There is no
+//! trend with N inside the noise: the trimmed centroid (three O(n)
+//! selections over all points) and the per-point loop dominate; N only adds
+//! the zeroing and the per-pixel division of N² cells (50k at 224).
+//! Preprocessing never decides N; the CNN does: training cost grows with N²
 //! (MobileNetV3-Small 0.5 on 2 cores: 0.71 ms/image at 64 vs ~1 ms at 96,
-//! `/work/shared/notes/cnn-and-onnx.md`) and inference with it too
-//! (tract 0.48 ms at 64, 3.1 ms at 224). With a ~1 h training budget on two
-//! shared cores, N = 64 is the default ([`DEFAULT_IMAGE_SIZE`]); with
-//! l = 4 m a pixel is then 6.25 cm, finer than the 15 cm success threshold
-//! and comparable to the Mid-40 point spacing at 10-20 m.
+//! `/work/shared/notes/cnn-and-onnx.md`) and inference too (tract 0.48 ms at
+//! 64, 3.1 ms at 224). With a ~1 h training budget on two shared cores,
+//! N = 64 is the default ([`DEFAULT_IMAGE_SIZE`]); with l = 4 m a pixel is
+//! then 6.25 cm, finer than the 15 cm success threshold and comparable to
+//! the Mid-40 point spacing at 10-20 m.
 
 use nalgebra::Vector3;
 use spacepose_geometry::centroid::trimmed_centroid_with_scratch;
