@@ -23,8 +23,16 @@ pub enum Command {
     /// Evaluate an estimator against ground truth.
     #[command(subcommand)]
     Eval(EvalCommand),
-    /// Start the services of a deployment descriptor and wait for their health.
+    /// Start the services of a deployment descriptor and wait for their
+    /// health; a supervisor process stays behind (restarts, swaps, status).
     Up(UpArgs),
+    /// The supervisor `spacepose up` leaves running (internal).
+    #[command(hide = true)]
+    Supervise(UpArgs),
+    /// Swap an estimator of a running deployment: start the new instance,
+    /// warm it from the filter state, switch the primary at a frame
+    /// boundary, stop the old one.
+    Swap(SwapArgs),
     /// Show the instances of running deployments.
     Status(PrefixArgs),
     /// Stop a deployment (SIGTERM, then SIGKILL) and clean up after it.
@@ -60,6 +68,25 @@ pub struct UpArgs {
     pub overrides: ZenohOverrideArgs,
 }
 
+/// `spacepose swap`.
+#[derive(Debug, Args)]
+pub struct SwapArgs {
+    /// Kind of service to swap (`tracker`).
+    pub kind: String,
+    /// New tracking mode (ndt, deblur, ct-ndt, icp).
+    #[arg(long)]
+    pub mode: Option<String>,
+    /// New binary (e.g. a new build of spacepose-tracker).
+    #[arg(long)]
+    pub binary: Option<PathBuf>,
+    /// Deployment prefix (default: the only one running).
+    #[arg(long)]
+    pub prefix: Option<String>,
+    /// How long to wait for the swap to finish (s).
+    #[arg(long, default_value_t = 90.0)]
+    pub timeout_s: f64,
+}
+
 /// `spacepose status` / `spacepose down`.
 #[derive(Debug, Args)]
 pub struct PrefixArgs {
@@ -86,6 +113,13 @@ pub struct DemoArgs {
     /// Seconds to wait for missing poses once the sensor stops.
     #[arg(long, default_value_t = 5.0)]
     pub linger_s: f64,
+    /// Inject a fault: `kill:NAME@K` (SIGKILL) or `stop:NAME@K` (SIGSTOP,
+    /// a freeze) once frame K is published (repeatable).
+    #[arg(long)]
+    pub chaos: Vec<String>,
+    /// Swap the primary tracker during the run: `MODE@K` (e.g. `ct-ndt@5`).
+    #[arg(long)]
+    pub swap: Option<String>,
     /// Overrides (default prefix: a fresh random one).
     #[command(flatten)]
     pub overrides: ZenohOverrideArgs,

@@ -14,6 +14,8 @@ fn main() -> ExitCode {
         Command::Sim(args) => spacepose::sim_cmd::run(&args),
         Command::Eval(EvalCommand::Tracking(args)) => spacepose::eval::tracking::run(&args),
         Command::Up(args) => spacepose::suite::cmd::up(&args),
+        Command::Supervise(args) => spacepose::suite::cmd::supervise(&args),
+        Command::Swap(args) => spacepose::suite::cmd::swap(&args),
         Command::Status(args) => spacepose::suite::cmd::status(&args),
         Command::Down(args) => spacepose::suite::cmd::down(&args),
         Command::Demo(args) => spacepose::suite::cmd::demo(&args),

@@ -2,7 +2,7 @@
 
 use super::demo::DemoOptions;
 use super::up::Overrides;
-use crate::cli::{DemoArgs, GroundArgs, PrefixArgs, UpArgs, ZenohOverrideArgs};
+use crate::cli::{DemoArgs, GroundArgs, PrefixArgs, SwapArgs, UpArgs, ZenohOverrideArgs};
 use crate::ground::GroundOptions;
 use anyhow::{Result, bail};
 use std::time::Duration;
@@ -27,6 +27,29 @@ pub fn up(a: &UpArgs) -> Result<()> {
     super::up::run(&a.deploy, &overrides(&a.overrides), &mut std::io::stdout())
 }
 
+/// `spacepose supervise` (started by `up`).
+pub fn supervise(a: &UpArgs) -> Result<()> {
+    super::up::supervise(&a.deploy, &overrides(&a.overrides))
+}
+
+/// `spacepose swap`.
+pub fn swap(a: &SwapArgs) -> Result<()> {
+    let kind: super::kind::ServiceKind = toml::Value::String(a.kind.clone())
+        .try_into()
+        .map_err(|_| anyhow::anyhow!("unknown service kind {:?}", a.kind))?;
+    let req = super::swap::SwapRequest {
+        kind,
+        mode: a.mode.clone(),
+        binary: a.binary.clone(),
+    };
+    super::up::request_swap(
+        a.prefix.as_deref(),
+        &req,
+        seconds("--timeout-s", a.timeout_s)?,
+        &mut std::io::stdout(),
+    )
+}
+
 /// `spacepose status`.
 pub fn status(a: &PrefixArgs) -> Result<()> {
     super::status::run(a.prefix.as_deref(), &mut std::io::stdout())
@@ -46,6 +69,16 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
         json: a.json.clone(),
         overrides: overrides(&a.overrides),
         linger: seconds("--linger-s", a.linger_s)?,
+        chaos: a
+            .chaos
+            .iter()
+            .map(|c| super::demo::chaos::ChaosSpec::parse(c))
+            .collect::<Result<_>>()?,
+        swap: a
+            .swap
+            .as_deref()
+            .map(super::demo::chaos::SwapSpec::parse)
+            .transpose()?,
     };
     super::demo::run(&opts, &mut std::io::stdout())?;
     Ok(())

@@ -14,6 +14,7 @@
 //! service's own binary checks (`--check`).
 
 use super::kind::ServiceKind;
+use super::restart::{Policy, RestartSettings};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -33,6 +34,13 @@ pub struct Descriptor {
     /// How long `up` waits for every instance's first heartbeat (s).
     #[serde(default = "default_health_timeout_s")]
     pub health_timeout_s: f64,
+    /// A service whose last heartbeat is older than this is hung (ms);
+    /// default: 3 heartbeat periods + 100 ms.
+    #[serde(default)]
+    pub hang_timeout_ms: Option<u64>,
+    /// Restart policy of the supervisor (`spacepose up`, `spacepose demo`).
+    #[serde(default)]
+    pub restart: RestartSettings,
     /// zenoh endpoints of the suite (given to the services that use zenoh).
     #[serde(default)]
     pub zenoh: ZenohEndpoints,
@@ -81,6 +89,9 @@ pub struct ServiceEntry {
     /// the descriptor's directory.
     #[serde(default)]
     pub binary: Option<PathBuf>,
+    /// Restart policy of this instance (default: the descriptor's `[restart]`).
+    #[serde(default)]
+    pub restart_policy: Option<Policy>,
     /// The service's configuration, written to a TOML file and passed with `--config`.
     #[serde(default)]
     pub config: toml::Table,

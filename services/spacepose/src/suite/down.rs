@@ -4,15 +4,29 @@ use super::launch::STOP_GRACE;
 use super::process::terminate;
 use super::state::RunState;
 use anyhow::{Context, Result};
-use iceoryx2::prelude::*;
 use spacepose_bus::{cleanup_dead_nodes, iceoryx2_config};
 use spacepose_messages::Names;
 use std::io::Write;
 use std::path::Path;
 
-/// Stops the deployment `prefix` (the only one running when `None`).
+/// Stops the deployment `prefix` (the only one running when `None`): its
+/// supervisor first (which stops the services), then whatever is left; returns
+/// once every process has exited.
 pub fn run(prefix: Option<&str>, out: &mut dyn Write) -> Result<()> {
     let state = RunState::select(prefix)?;
+    if let Some(pid) = state.supervisor_pid.filter(|p| *p != std::process::id()) {
+        let exe = std::env::current_exe()?;
+        // The supervisor stops the services itself; it gets their grace
+        // period plus its own.
+        let killed = terminate(
+            &[("supervisor", pid, exe.as_path())],
+            STOP_GRACE + std::time::Duration::from_secs(3),
+            || {},
+        );
+        if !killed.is_empty() {
+            writeln!(out, "the supervisor (pid {pid}) had to be killed")?;
+        }
+    }
     let procs: Vec<(&str, u32, &Path)> = state
         .instances
         .iter()
@@ -33,6 +47,14 @@ pub fn run(prefix: Option<&str>, out: &mut dyn Write) -> Result<()> {
             killed.join(", ")
         )?;
     }
+    let left: Vec<&str> = procs
+        .iter()
+        .filter(|(_, pid, b)| super::process::is_alive(*pid, b))
+        .map(|(n, _, _)| *n)
+        .collect();
+    if !left.is_empty() {
+        anyhow::bail!("still running after SIGKILL: {}", left.join(", "));
+    }
     cleanup(&state.prefix, out)
 }
 
@@ -49,64 +71,9 @@ pub fn cleanup(prefix: &str, out: &mut dyn Write) -> Result<()> {
             "removed the resources of {cleaned} dead iceoryx2 node(s)"
         )?;
     }
-    let mut alive = 0usize;
-    let listed = Node::<ipc::Service>::list(&config, |_| {
-        alive += 1;
-        CallbackProgression::Continue
-    });
-    if listed.is_ok() && alive == 0 {
-        let removed = remove_shm_files(Path::new("/dev/shm"), &names.iceoryx2_prefix());
-        if removed > 0 {
-            tracing::info!(removed, "removed shared-memory files of {prefix:?}");
-        }
+    let removed = spacepose_bus::node::remove_deployment_files(&names)?;
+    if removed > 0 {
+        tracing::info!(removed, "removed shared-memory files of {prefix:?}");
     }
     Ok(())
-}
-
-/// True for an iceoryx2 file of exactly this prefix (`{iox_prefix}{40 hex}_…`):
-/// prefix `a` must not match the files of prefix `a_b`.
-fn is_prefix_file(name: &str, iox_prefix: &str) -> bool {
-    name.strip_prefix(iox_prefix).is_some_and(|rest| {
-        rest.len() > 41
-            && rest.as_bytes()[..40].iter().all(u8::is_ascii_hexdigit)
-            && rest.as_bytes()[40] == b'_'
-    })
-}
-
-fn remove_shm_files(dir: &Path, iox_prefix: &str) -> usize {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return 0;
-    };
-    entries
-        .flatten()
-        .filter(|e| {
-            e.file_name()
-                .to_str()
-                .is_some_and(|n| is_prefix_file(n, iox_prefix))
-        })
-        .filter(|e| std::fs::remove_file(e.path()).is_ok())
-        .count()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn only_files_of_the_exact_prefix_match() {
-        let hash = "9204dd183d1c4d8e1ff592a30766ffa6765aa8b5";
-        assert!(is_prefix_file(
-            &format!("sp_a_{hash}_node.0_10_0.global_mgmt"),
-            "sp_a_"
-        ));
-        assert!(!is_prefix_file(
-            &format!("sp_a_b_{hash}_node.global_mgmt"),
-            "sp_a_"
-        ));
-        assert!(is_prefix_file(
-            &format!("sp_a_b_{hash}_node.global_mgmt"),
-            "sp_a_b_"
-        ));
-        assert!(!is_prefix_file("sp_a_", "sp_a_"));
-    }
 }

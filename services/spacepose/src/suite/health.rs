@@ -11,6 +11,7 @@ pub struct HealthWatch {
     subscriber: Subscriber<Health>,
     waiter: Waiter,
     latest: BTreeMap<String, Health>,
+    received: BTreeMap<String, Instant>,
 }
 
 impl std::fmt::Debug for HealthWatch {
@@ -33,6 +34,7 @@ impl HealthWatch {
             subscriber,
             waiter,
             latest: BTreeMap::new(),
+            received: BTreeMap::new(),
         })
     }
 
@@ -50,7 +52,9 @@ impl HealthWatch {
     pub fn drain(&mut self) -> Result<usize> {
         let mut n = 0;
         while let Some(h) = self.subscriber.try_recv()? {
-            self.latest.insert(h.instance.as_str().to_string(), h);
+            let name = h.instance.as_str().to_string();
+            self.received.insert(name.clone(), Instant::now());
+            self.latest.insert(name, h);
             n += 1;
         }
         Ok(n)
@@ -68,6 +72,11 @@ impl HealthWatch {
     /// The latest heartbeat of `instance`.
     pub fn get(&self, instance: &str) -> Option<&Health> {
         self.latest.get(instance)
+    }
+
+    /// When the latest heartbeat of `instance` was received (this clock).
+    pub fn received_at(&self, instance: &str) -> Option<Instant> {
+        self.received.get(instance).copied()
     }
 
     /// Every instance seen, by name.

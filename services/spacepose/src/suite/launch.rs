@@ -39,7 +39,7 @@ fn instance_args(plan: &Plan, instance: &PlannedInstance, config: &std::path::Pa
 
 /// Refuses to start over a live deployment of the same prefix; removes a
 /// stale state file.
-fn check_not_running(prefix: &str) -> Result<()> {
+pub fn check_not_running(prefix: &str) -> Result<()> {
     let Ok(old) = RunState::load(prefix) else {
         return Ok(());
     };
@@ -66,12 +66,20 @@ pub fn start(plan: &Plan, watch: &mut HealthWatch, out: &mut dyn Write) -> Resul
     check_not_running(&prefix)?;
     let dir = run_dir(&prefix);
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    // NDT maps cached by an earlier run of this prefix may be of another target.
+    for e in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
+        if e.path().extension().is_some_and(|x| x == "ndtmap") {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
     let mut suite = RunningSuite {
         state: RunState {
             prefix: prefix.clone(),
             heartbeat_ms: plan.heartbeat_ms,
             started_unix_s: unix_now_s(),
             started_by_pid: std::process::id(),
+            supervisor_pid: None,
+            primary: super::supervisor::configured_primary(plan),
             instances: Vec::new(),
         },
         children: Vec::new(),
@@ -94,35 +102,16 @@ fn start_stage(
     watch: &mut HealthWatch,
     out: &mut dyn Write,
 ) -> Result<()> {
-    let dir = run_dir(plan.names.prefix());
     let first = suite.children.len();
     for instance in stage {
-        let config = dir.join(format!("{}.toml", instance.name));
-        std::fs::write(&config, toml::to_string(&instance.config)?)
-            .with_context(|| format!("cannot write {}", config.display()))?;
-        let log = dir.join(format!("{}.log", instance.name));
+        let log = run_dir(plan.names.prefix()).join(format!("{}.log", instance.name));
         let _ = std::fs::remove_file(&log);
-        let child = spawn_logged(
-            &instance.binary,
-            &instance_args(plan, instance, &config),
-            &log,
-        )
-        .with_context(|| format!("service {:?}", instance.name))?;
+        let pid = suite.spawn_instance(plan, instance)?;
         writeln!(
             out,
             "started {:<12} {:<10} pid {}",
-            instance.name,
-            instance.kind,
-            child.id()
+            instance.name, instance.kind, pid
         )?;
-        suite.state.instances.push(InstanceState {
-            name: instance.name.clone(),
-            kind: instance.kind,
-            pid: child.id(),
-            binary: instance.binary.clone(),
-            log,
-        });
-        suite.children.push(child);
         // Keep a partial state file, so `down` can stop a half-started suite.
         suite.state.save()?;
     }
@@ -182,6 +171,80 @@ fn wait_healthy(
 }
 
 impl RunningSuite {
+    /// Starts `instance` (config file written, log appended). When an
+    /// instance of that name exists (a restart), its process is replaced.
+    /// Returns the pid.
+    pub fn spawn_instance(&mut self, plan: &Plan, instance: &PlannedInstance) -> Result<u32> {
+        let dir = run_dir(plan.names.prefix());
+        let config = dir.join(format!("{}.toml", instance.name));
+        std::fs::write(&config, toml::to_string(&instance.config)?)
+            .with_context(|| format!("cannot write {}", config.display()))?;
+        let log = dir.join(format!("{}.log", instance.name));
+        let child = spawn_logged(
+            &instance.binary,
+            &instance_args(plan, instance, &config),
+            &log,
+        )
+        .with_context(|| format!("service {:?}", instance.name))?;
+        let pid = child.id();
+        let state = InstanceState {
+            name: instance.name.clone(),
+            kind: instance.kind,
+            pid,
+            binary: instance.binary.clone(),
+            log,
+            role: String::new(),
+            status: "starting".into(),
+            restarts: 0,
+            last_frame: None,
+        };
+        match self.index(&instance.name) {
+            Some(i) => {
+                let old = &mut self.state.instances[i];
+                let restarts = old.restarts;
+                let role = std::mem::take(&mut old.role);
+                *old = InstanceState {
+                    restarts,
+                    role,
+                    ..state
+                };
+                self.children[i] = child;
+            }
+            None => {
+                self.state.instances.push(state);
+                self.children.push(child);
+            }
+        }
+        Ok(pid)
+    }
+
+    /// Index of an instance.
+    pub fn index(&self, instance: &str) -> Option<usize> {
+        self.state.instances.iter().position(|i| i.name == instance)
+    }
+
+    /// The exit status of an instance whose process has exited (reaped).
+    pub fn try_exit(&mut self, instance: &str) -> Option<std::process::ExitStatus> {
+        let i = self.index(instance)?;
+        self.children[i].try_wait().ok().flatten()
+    }
+
+    /// Sends `signal` to an instance's process group.
+    pub fn signal(&self, instance: &str, signal: rustix::process::Signal) {
+        if let Some(pid) = self.pid(instance) {
+            super::process::signal_group(pid, signal);
+        }
+    }
+
+    /// Forgets an instance (after it exited, e.g. swapped out).
+    pub fn remove(&mut self, instance: &str) {
+        if let Some(i) = self.index(instance) {
+            let mut child = self.children.remove(i);
+            let _ = child.try_wait();
+            self.state.instances.remove(i);
+        }
+    }
+
     /// Process id of an instance.
     pub fn pid(&self, instance: &str) -> Option<u32> {
         self.state

@@ -1,5 +1,5 @@
 //! The service suite: deployment descriptors, `up`, `status`, `down` and
-//! the `demo` main job. Processes are started from a validated [`plan::Plan`];
+//! the `demo` main job, the supervisor (restarts, hang detection, swaps). Processes are started from a validated [`plan::Plan`];
 //! nothing starts when a descriptor has a problem.
 
 pub mod binaries;
@@ -13,6 +13,9 @@ pub mod kind;
 pub mod launch;
 pub mod plan;
 pub mod process;
+pub mod restart;
 pub mod state;
 pub mod status;
+pub mod supervisor;
+pub mod swap;
 pub mod up;

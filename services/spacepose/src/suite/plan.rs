@@ -5,6 +5,7 @@ use super::binaries::BinarySearch;
 use super::config_check::check_config;
 use super::descriptor::{Descriptor, ZenohEndpoints};
 use super::kind::ServiceKind;
+use super::restart::{Policy, RestartSettings};
 use spacepose_messages::{Name, Names, Topic};
 use std::collections::{BTreeSet, HashMap};
 use std::path::PathBuf;
@@ -19,6 +20,10 @@ pub struct Plan {
     pub heartbeat_ms: u64,
     /// How long to wait for every first heartbeat.
     pub health_timeout: Duration,
+    /// A service silent for longer than this is hung.
+    pub hang_timeout: Duration,
+    /// Restart settings of the supervisor.
+    pub restart: RestartSettings,
     /// zenoh endpoints of the suite.
     pub zenoh: ZenohEndpoints,
     /// The instances, in descriptor order.
@@ -36,6 +41,8 @@ pub struct PlannedInstance {
     pub binary: PathBuf,
     /// Configuration (with the deployment's zenoh endpoints filled in).
     pub config: toml::Table,
+    /// Restart policy.
+    pub restart_policy: Policy,
 }
 
 /// Every problem of a descriptor, one line each.
@@ -76,13 +83,25 @@ pub fn truth_init(config: &toml::Table) -> bool {
 }
 
 /// Fills in what the deployment decides for a service: the zenoh endpoints
-/// of telemetry (unless its config sets its own `zenoh` table).
+/// of telemetry (unless its config sets its own `zenoh` table), and the NDT
+/// map file of a tracker (unless it sets `map_file`): `map_dir/{name}.ndtmap`,
+/// built on the first start and loaded by every restart, so a restarted
+/// tracker is back within a fraction of a second instead of rebuilding it.
 pub fn deployment_config(
     kind: ServiceKind,
     config: &toml::Table,
     zenoh: &ZenohEndpoints,
+    map_dir: &std::path::Path,
+    name: &str,
 ) -> toml::Table {
     let mut config = config.clone();
+    if kind == ServiceKind::Tracker && !config.contains_key("map_file") {
+        let path = map_dir.join(format!("{name}.ndtmap"));
+        config.insert(
+            "map_file".into(),
+            toml::Value::String(path.display().to_string()),
+        );
+    }
     if kind == ServiceKind::Telemetry && !config.contains_key("zenoh") {
         let mut z = toml::Table::new();
         let list =
@@ -116,6 +135,13 @@ pub fn plan(
     if descriptor.heartbeat_ms == 0 {
         problems.push("heartbeat_ms must be >= 1".to_string());
     }
+    if descriptor
+        .hang_timeout_ms
+        .is_some_and(|h| h <= descriptor.heartbeat_ms)
+    {
+        problems.push("hang_timeout_ms must be longer than heartbeat_ms".to_string());
+    }
+    problems.extend(descriptor.restart.problems());
     check_instance_names(descriptor, &mut problems);
     check_topics(descriptor, &mut problems);
     let mut instances = Vec::new();
@@ -127,7 +153,8 @@ pub fn plan(
                 continue;
             }
         };
-        let config = deployment_config(s.kind, &s.config, &descriptor.zenoh);
+        let map_dir = super::state::run_dir(&descriptor.prefix);
+        let config = deployment_config(s.kind, &s.config, &descriptor.zenoh, &map_dir, &s.name);
         if check == ConfigCheck::Run
             && let Err(e) = check_config(&binary, &config)
         {
@@ -141,6 +168,7 @@ pub fn plan(
             kind: s.kind,
             binary,
             config,
+            restart_policy: s.restart_policy.unwrap_or(descriptor.restart.policy),
         });
     }
     match names {
@@ -148,6 +176,12 @@ pub fn plan(
             names,
             heartbeat_ms: descriptor.heartbeat_ms,
             health_timeout: Duration::from_secs_f64(descriptor.health_timeout_s),
+            hang_timeout: Duration::from_millis(
+                descriptor
+                    .hang_timeout_ms
+                    .unwrap_or(3 * descriptor.heartbeat_ms + 100),
+            ),
+            restart: descriptor.restart.clone(),
             zenoh: descriptor.zenoh.clone(),
             instances,
         }),

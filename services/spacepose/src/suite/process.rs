@@ -54,7 +54,9 @@ pub fn is_alive(pid: u32, binary: &Path) -> bool {
     argv0.file_name() == binary.file_name()
 }
 
-fn signal_group(pid: u32, signal: Signal) {
+/// Sends `signal` to the process group led by `pid` (each service leads
+/// its own), or to the process alone when that fails.
+pub fn signal_group(pid: u32, signal: Signal) {
     let Some(pid) = i32::try_from(pid).ok().and_then(Pid::from_raw) else {
         return;
     };

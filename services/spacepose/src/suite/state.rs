@@ -27,6 +27,13 @@ pub struct RunState {
     pub started_unix_s: f64,
     /// pid of the `spacepose` process that started the suite.
     pub started_by_pid: u32,
+    /// pid of the supervising `spacepose` process (`up` leaves one running;
+    /// the demo is its own supervisor).
+    #[serde(default)]
+    pub supervisor_pid: Option<u32>,
+    /// The filter's primary tracker instance (redundant deployments).
+    #[serde(default)]
+    pub primary: Option<String>,
     /// The instances.
     pub instances: Vec<InstanceState>,
 }
@@ -44,6 +51,19 @@ pub struct InstanceState {
     pub binary: PathBuf,
     /// Log file (stdout and stderr).
     pub log: PathBuf,
+    /// `primary` or `standby` for redundant trackers, empty otherwise.
+    #[serde(default)]
+    pub role: String,
+    /// What the supervisor knows: `starting`, `running`, `hung`,
+    /// `restarting`, `failed`, `stopping`, `exited`.
+    #[serde(default)]
+    pub status: String,
+    /// Restarts by the supervisor.
+    #[serde(default)]
+    pub restarts: u32,
+    /// Last frame the instance reported in its heartbeat.
+    #[serde(default)]
+    pub last_frame: Option<u64>,
 }
 
 impl RunState {

@@ -27,10 +27,19 @@ pub fn run(prefix: Option<&str>, out: &mut dyn Write) -> Result<()> {
         // Two heartbeat periods: every live instance reports at least once.
         watch.collect_for(Duration::from_millis(2 * state.heartbeat_ms + 200))?;
         let age_s = super::state::unix_now_s() - state.started_unix_s;
+        let supervisor = match state.supervisor_pid {
+            Some(pid) if std::env::current_exe().is_ok_and(|e| is_alive(pid, &e)) => {
+                format!("supervisor pid {pid}")
+            }
+            Some(pid) => format!("supervisor pid {pid} NOT RUNNING"),
+            None => "no supervisor".to_string(),
+        };
         writeln!(
             out,
-            "deployment {:?}, started {:.0} s ago",
-            state.prefix, age_s
+            "deployment {:?}, started {:.0} s ago, {supervisor}, primary tracker: {}",
+            state.prefix,
+            age_s,
+            state.primary.as_deref().unwrap_or("-")
         )?;
         write!(out, "{}", render(&state, &watch))?;
     }
@@ -42,8 +51,11 @@ pub fn render(state: &RunState, watch: &HealthWatch) -> String {
     let mut t = Table::new(&[
         "instance",
         "kind",
+        "role",
         "pid",
         "alive",
+        "supervisor",
+        "restarts",
         "health",
         "frames in",
         "frames out",
@@ -56,18 +68,30 @@ pub fn render(state: &RunState, watch: &HealthWatch) -> String {
     for i in &state.instances {
         let alive = is_alive(i.pid, &i.binary);
         let h = watch.get(&i.name).filter(|h| h.pid == i.pid);
+        let dash = |v: &str| {
+            if v.is_empty() {
+                "-".to_string()
+            } else {
+                v.to_string()
+            }
+        };
         let mut row = vec![
             i.name.clone(),
             i.kind.to_string(),
+            dash(&i.role),
             i.pid.to_string(),
             if alive { "yes" } else { "no" }.to_string(),
+            dash(&i.status),
+            i.restarts.to_string(),
         ];
         match h {
             Some(h) => row.extend(health_cells(h, now_ns)),
             None => row.extend(
                 ["no heartbeat".to_string()]
                     .into_iter()
-                    .chain(std::iter::repeat_n("-".to_string(), 6)),
+                    .chain(std::iter::repeat_n("-".to_string(), 4))
+                    .chain([i.last_frame.map_or("-".to_string(), |f| f.to_string())])
+                    .chain(["-".to_string()]),
             ),
         }
         t.row(row);

@@ -9,7 +9,9 @@ use super::plan::{ConfigCheck, Plan, plan};
 use anyhow::{Context, Result};
 use spacepose_bus::Bus;
 use std::io::Write;
+use std::os::unix::process::CommandExt;
 use std::path::Path;
+use std::time::Duration;
 
 /// Command-line overrides of a descriptor.
 #[derive(Debug, Clone, Default)]
@@ -69,20 +71,191 @@ pub fn bring_up(
     Ok((bus, watch, suite))
 }
 
-/// `spacepose up <descriptor>`.
+/// Output of the supervisor: its log file, and stdout until the suite is
+/// ready (`up` reads it through a pipe, then exits).
+struct SupervisorOut {
+    stdout: Option<std::io::Stdout>,
+    log: std::fs::File,
+}
+
+impl Write for SupervisorOut {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if let Some(o) = &mut self.stdout {
+            let _ = o.write_all(buf);
+        }
+        self.log.write_all(buf)?;
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        if let Some(o) = &mut self.stdout {
+            let _ = o.flush();
+        }
+        self.log.flush()
+    }
+}
+
+/// The line the supervisor prints once every instance is healthy.
+const READY: &str = "supervisor ready";
+
+fn override_args(overrides: &Overrides) -> Vec<String> {
+    let mut args = Vec::new();
+    if let Some(p) = &overrides.prefix {
+        args.extend(["--prefix".to_string(), p.clone()]);
+    }
+    for l in overrides.listen.iter().flatten() {
+        args.extend(["--listen".to_string(), l.clone()]);
+    }
+    for c in overrides.connect.iter().flatten() {
+        args.extend(["--connect".to_string(), c.clone()]);
+    }
+    args
+}
+
+/// `spacepose up <descriptor>`: validates, then starts the supervisor
+/// process (`spacepose supervise`, its own process group, log in the run
+/// directory), relays its progress and returns once the suite is healthy.
 pub fn run(path: &Path, overrides: &Overrides, out: &mut dyn Write) -> Result<()> {
+    use std::io::BufRead;
     let (_, plan) = load_plan(path, overrides)?;
-    let (bus, watch, suite) = bring_up(&plan, "up", out)?;
-    drop(watch);
-    drop(bus);
-    let state = suite.detach();
-    writeln!(
-        out,
-        "deployment {:?} is up ({} instances); logs in {}; stop it with `spacepose down --prefix {}`",
-        state.prefix,
-        state.instances.len(),
-        super::state::run_dir(&state.prefix).display(),
-        state.prefix
-    )?;
+    let prefix = plan.names.prefix().to_string();
+    super::launch::check_not_running(&prefix)?;
+    let dir = super::state::run_dir(&prefix);
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let log_path = dir.join("supervisor.log");
+    let log = std::fs::File::create(&log_path)
+        .with_context(|| format!("cannot create {}", log_path.display()))?;
+    let exe = std::env::current_exe().context("locating the spacepose executable")?;
+    let mut overrides = overrides.clone();
+    overrides.prefix = Some(prefix.clone());
+    let mut child = std::process::Command::new(exe)
+        .arg("supervise")
+        .arg(path)
+        .args(override_args(&overrides))
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
+        .stderr(log)
+        .process_group(0)
+        .spawn()
+        .context("starting the supervisor")?;
+    let stdout = child.stdout.take().context("supervisor stdout")?;
+    for line in std::io::BufReader::new(stdout).lines() {
+        let line = line?;
+        if line == READY {
+            writeln!(
+                out,
+                "deployment {prefix:?} is up, supervised by pid {}; logs in {}; \
+                 stop it with `spacepose down --prefix {prefix}`",
+                child.id(),
+                dir.display()
+            )?;
+            return Ok(());
+        }
+        writeln!(out, "{line}")?;
+    }
+    let status = child.wait()?;
+    anyhow::bail!(
+        "the supervisor exited ({status}) before the suite was up; last lines of {}:\n{}",
+        log_path.display(),
+        super::process::log_tail(&log_path, 20)
+    )
+}
+
+/// Path of the swap request / result files of a deployment.
+fn swap_files(prefix: &str) -> (std::path::PathBuf, std::path::PathBuf) {
+    let dir = super::state::run_dir(prefix);
+    (dir.join("swap-request.json"), dir.join("swap-result.json"))
+}
+
+/// `spacepose supervise`: brings the suite up and supervises it until
+/// SIGTERM/SIGINT (`spacepose down`), then stops it.
+pub fn supervise(path: &Path, overrides: &Overrides) -> Result<()> {
+    use std::sync::atomic::Ordering;
+    let (_, plan) = load_plan(path, overrides)?;
+    let prefix = plan.names.prefix().to_string();
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    for sig in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
+        signal_hook::flag::register(sig, std::sync::Arc::clone(&stop))?;
+    }
+    let log_path = super::state::run_dir(&prefix).join("supervisor.log");
+    let log = std::fs::File::options()
+        .create(true)
+        .append(true)
+        .open(&log_path)?;
+    let mut out = SupervisorOut {
+        stdout: Some(std::io::stdout()),
+        log,
+    };
+    let (bus, watch, suite) = bring_up(&plan, "supervisor", &mut out)?;
+    let mut sup = super::supervisor::Supervisor::new(plan, bus, watch, suite)?;
+    writeln!(out, "{READY}")?;
+    out.flush()?;
+    out.stdout = None;
+    let (request, result) = swap_files(&prefix);
+    let mut reported = 0;
+    while !stop.load(Ordering::Relaxed) {
+        sup.step(&mut out)?;
+        if request.exists() {
+            let taken = request.with_extension("taken");
+            std::fs::rename(&request, &taken)?;
+            let req = std::fs::read_to_string(&taken)
+                .map_err(anyhow::Error::from)
+                .and_then(|t| Ok(serde_json::from_str::<super::swap::SwapRequest>(&t)?));
+            if let Err(e) = req.and_then(|r| sup.request_swap(r, &mut out)) {
+                write_json(&result, &serde_json::json!({ "error": format!("{e:#}") }))?;
+            }
+        }
+        if sup.swaps.len() > reported {
+            reported = sup.swaps.len();
+            write_json(&result, &sup.swaps[reported - 1])?;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    writeln!(out, "supervisor: stopping the suite")?;
+    sup.stop(&mut out)
+}
+
+fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
+    let tmp = path.with_extension("tmp");
+    std::fs::write(&tmp, serde_json::to_string_pretty(value)?)?;
+    std::fs::rename(&tmp, path)?;
     Ok(())
+}
+
+/// `spacepose swap`: hands the request to the deployment's supervisor and
+/// waits for its report.
+pub fn request_swap(
+    prefix: Option<&str>,
+    req: &super::swap::SwapRequest,
+    timeout: Duration,
+    out: &mut dyn Write,
+) -> Result<()> {
+    let state = super::state::RunState::select(prefix)?;
+    let alive = state.supervisor_pid.is_some_and(|pid| {
+        std::env::current_exe().is_ok_and(|exe| super::process::is_alive(pid, &exe))
+    });
+    if !alive {
+        anyhow::bail!(
+            "deployment {:?} has no running supervisor (started by an older `spacepose up`?)",
+            state.prefix
+        );
+    }
+    let (request, result) = swap_files(&state.prefix);
+    let _ = std::fs::remove_file(&result);
+    write_json(&request, req)?;
+    writeln!(out, "swap requested on {:?}", state.prefix)?;
+    let start = std::time::Instant::now();
+    while start.elapsed() < timeout {
+        if let Ok(text) = std::fs::read_to_string(&result) {
+            let v: serde_json::Value = serde_json::from_str(&text)?;
+            if let Some(e) = v.get("error").and_then(serde_json::Value::as_str) {
+                anyhow::bail!("swap failed: {e}");
+            }
+            let r: super::swap::SwapReport = serde_json::from_value(v)?;
+            writeln!(out, "{}", r.line())?;
+            return Ok(());
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    anyhow::bail!("no swap result within {} s", timeout.as_secs_f64())
 }

@@ -5,17 +5,19 @@
 //! Truth only scores: the demo (like telemetry) is a scorer and subscribes
 //! to `truth`; no estimator sees it.
 
+pub mod chaos;
 pub mod report;
 pub mod score;
 
 use super::descriptor::Descriptor;
 use super::kind::ServiceKind;
-use super::launch::RunningSuite;
+use super::supervisor::Supervisor;
 use super::up::{Overrides, bring_up, plan_descriptor};
 use anyhow::{Context, Result, bail};
+use chaos::{Action, ChaosSpec, Injection, SwapSpec};
 use score::{Scorer, Summary};
 use spacepose_bus::{Bus, CloudSubscriber, Subscriber, WakeReason};
-use spacepose_messages::{Names, PoseEstimate, TruthMsg};
+use spacepose_messages::{FilterState, Names, PoseEstimate, TruthMsg, realtime_ns};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -35,6 +37,10 @@ pub struct DemoOptions {
     pub overrides: Overrides,
     /// How long to wait for a missing pose after the last frame.
     pub linger: Duration,
+    /// Faults to inject.
+    pub chaos: Vec<ChaosSpec>,
+    /// A swap of the primary tracker during the run.
+    pub swap: Option<SwapSpec>,
 }
 
 /// A fresh prefix (`demo-` and 8 hex digits from the pid and the clock),
@@ -81,6 +87,7 @@ fn demo_descriptor(opts: &DemoOptions) -> Result<Descriptor> {
 struct Ports {
     poses: Subscriber<PoseEstimate>,
     truth: Subscriber<TruthMsg>,
+    states: Subscriber<FilterState>,
     raw: CloudSubscriber,
 }
 
@@ -89,14 +96,27 @@ impl Ports {
         Ok(Self {
             poses: bus.subscriber(&names.pose())?,
             truth: bus.subscriber(&names.truth())?,
+            states: bus.subscriber(&names.filter_state())?,
             raw: bus.cloud_subscriber(&names.raw_cloud())?,
         })
     }
 
-    fn drain(&self, scorer: &mut Scorer, out: &mut dyn Write, start: Instant) -> Result<bool> {
+    /// Drains every port; returns whether a truth arrived and the newest
+    /// raw frame published.
+    fn drain(
+        &self,
+        scorer: &mut Scorer,
+        out: &mut dyn Write,
+        start: Instant,
+    ) -> Result<(bool, Option<u64>)> {
         let mut truth_seen = false;
+        let mut newest_raw = None;
         while let Some(c) = self.raw.try_recv()? {
+            newest_raw = newest_raw.max(Some(c.header().sequence));
             scorer.on_raw_cloud(c.header().sequence, c.header().published_ns);
+        }
+        while let Some(s) = self.states.try_recv()? {
+            scorer.on_state(&s);
         }
         let mut scored = Vec::new();
         while let Some(t) = self.truth.try_recv()? {
@@ -109,7 +129,7 @@ impl Ports {
         for f in scored {
             writeln!(out, "{}", report::live_line(&f, start.elapsed()))?;
         }
-        Ok(truth_seen)
+        Ok((truth_seen, newest_raw))
     }
 }
 
@@ -129,23 +149,54 @@ pub fn run(opts: &DemoOptions, out: &mut dyn Write) -> Result<Summary> {
     // Subscribe before anything starts, so no frame is missed.
     let bus = Bus::open(&names, &format!("spacepose-demo-{}", std::process::id()))?;
     let ports = Ports::open(&bus, &names)?;
-    let (up_bus, mut watch, mut suite) =
+    let (up_bus, watch, suite) =
         bring_up(&plan, "demo-up", out).context("the demo suite failed to start")?;
+    let mut sup = Supervisor::new(plan, up_bus, watch, suite)?;
     writeln!(out, "{}", report::live_header())?;
-    let followed = follow(opts, &bus, &ports, &mut suite, out);
-    let _ = watch.drain();
-    let health = super::status::render(&suite.state, &watch);
-    drop(watch);
-    drop(up_bus);
+    let mut injections: Vec<Injection> = opts
+        .chaos
+        .iter()
+        .map(|c| Injection {
+            spec: c.clone(),
+            at: None,
+            at_ns: 0,
+        })
+        .collect();
+    let followed = follow(opts, &bus, &ports, &mut sup, &mut injections, out);
+    // Frozen processes cannot stop: thaw them first.
+    for i in injections.iter().filter(|i| i.spec.action == Action::Stop) {
+        sup.suite
+            .signal(&i.spec.instance, rustix::process::Signal::CONT);
+    }
+    let _ = sup.watch.drain();
+    let _ = sup.save_state();
+    let health = super::status::render(&sup.suite.state, &sup.watch);
+    let restarts = sup
+        .suite
+        .state
+        .instances
+        .iter()
+        .map(|i| (i.name.clone(), i.restarts))
+        .collect();
+    let faults = sup.faults.clone();
+    let swap = sup.swaps.last().cloned();
     drop(ports);
     drop(bus);
-    let stopped = suite.stop(out);
+    let stopped = sup.stop(out);
     let scorer = followed?;
     stopped?;
     writeln!(out, "suite {:?} stopped", names.prefix())?;
-    let summary = Summary::new(names.prefix(), &scorer, opts.frames, opts.warmup);
+    let mut summary = Summary::new(names.prefix(), &scorer, opts.frames, opts.warmup);
+    let fusions = scorer.fusions();
+    summary.chaos = injections
+        .iter()
+        .map(|i| i.report(&faults, &fusions))
+        .collect();
+    summary.swap = swap;
+    summary.restarts = restarts;
     writeln!(out, "\nhealth at the end of the run:\n{health}")?;
     write!(out, "{}", report::final_table(&summary))?;
+    write!(out, "{}", report::chaos_lines(&summary))?;
     if let Some(path) = &opts.json {
         write_json(path, &summary)?;
         writeln!(out, "summary written to {}", path.display())?;
@@ -153,13 +204,18 @@ pub fn run(opts: &DemoOptions, out: &mut dyn Write) -> Result<Summary> {
     Ok(summary)
 }
 
+/// How long the demo keeps listening once every frame has a pose.
+const SETTLE: Duration = Duration::from_millis(300);
+
 /// Follows the run until every frame has a pose, or the sensor has stopped
-/// for `linger`, or a service died.
+/// for `linger`, or a service failed for good. The supervisor runs every
+/// few milliseconds in between; faults and the swap are injected on time.
 fn follow(
     opts: &DemoOptions,
     bus: &Bus,
     ports: &Ports,
-    suite: &mut RunningSuite,
+    sup: &mut Supervisor,
+    injections: &mut [Injection],
     out: &mut dyn Write,
 ) -> Result<Scorer> {
     let mut waiter = bus.waitset()?;
@@ -169,22 +225,48 @@ fn follow(
     let mut scorer = Scorer::default();
     let start = Instant::now();
     let mut last_truth = Instant::now();
+    let mut newest_raw: Option<u64> = None;
+    let mut swap = opts.swap.clone();
+    let mut done_at: Option<Instant> = None;
     // Generous: the first frame waits for the map and the acquisition.
     let first_frame_timeout = Duration::from_secs(60);
     loop {
-        if waiter.wait(Duration::from_millis(200))? == WakeReason::TerminationRequested {
+        if waiter.wait(Duration::from_millis(5))? == WakeReason::TerminationRequested {
             bail!("interrupted");
         }
-        if ports.drain(&mut scorer, out, start)? {
+        let (truth, raw) = ports.drain(&mut scorer, out, start)?;
+        if truth {
             last_truth = Instant::now();
         }
+        newest_raw = newest_raw.max(raw);
+        inject(sup, injections, newest_raw, out)?;
+        if let Some(s) = swap
+            .as_ref()
+            .filter(|s| newest_raw.is_some_and(|r| r >= s.at_frame))
+        {
+            let req = super::swap::SwapRequest {
+                kind: ServiceKind::Tracker,
+                mode: Some(s.mode.clone()),
+                binary: None,
+            };
+            writeln!(out, "swap: tracker -> {} at frame {}", s.mode, s.at_frame)?;
+            sup.request_swap(req, out)?;
+            swap = None;
+        }
+        sup.step(out)?;
         let done = scorer.truths() as u64 >= opts.frames
-            && scorer.scored().len() + scorer.unscorable as usize >= scorer.truths();
-        if done {
-            return Ok(scorer);
+            && scorer.scored().len() + scorer.unscorable as usize >= scorer.truths()
+            && !sup.swapping();
+        // Once every frame has a pose, wait a little for the filter states
+        // of the last frames (the filter may wait up to its frame deadline).
+        match (done, done_at) {
+            (true, None) => done_at = Some(Instant::now()),
+            (true, Some(t)) if t.elapsed() >= SETTLE => return Ok(scorer),
+            (false, _) => done_at = None,
+            _ => {}
         }
         let quiet = last_truth.elapsed();
-        if (scorer.truths() > 0 && quiet > opts.linger)
+        if (scorer.truths() > 0 && quiet > opts.linger && !sup.swapping())
             || (scorer.truths() == 0 && quiet > first_frame_timeout)
         {
             writeln!(
@@ -196,28 +278,54 @@ fn follow(
             )?;
             return Ok(scorer);
         }
-        check_processes(suite)?;
+        check_failed(sup)?;
     }
 }
 
-/// Fails when a non-source instance exited (a finished sensor may exit).
-fn check_processes(suite: &mut RunningSuite) -> Result<()> {
-    for (name, status) in suite.exited() {
-        let kind = suite
-            .state
-            .instances
-            .iter()
-            .find(|i| i.name == name)
-            .map(|i| i.kind);
-        if kind.is_some_and(ServiceKind::is_source) && status.contains("exit status: 0") {
-            continue;
+/// Injects the faults whose frame has been published.
+fn inject(
+    sup: &Supervisor,
+    injections: &mut [Injection],
+    newest_raw: Option<u64>,
+    out: &mut dyn Write,
+) -> Result<()> {
+    let Some(raw) = newest_raw else {
+        return Ok(());
+    };
+    for i in injections
+        .iter_mut()
+        .filter(|i| i.at.is_none() && raw >= i.spec.at_frame)
+    {
+        let Some(pid) = sup.suite.pid(&i.spec.instance) else {
+            bail!("--chaos: no instance {:?} in the suite", i.spec.instance);
+        };
+        let signal = match i.spec.action {
+            Action::Kill => rustix::process::Signal::KILL,
+            Action::Stop => rustix::process::Signal::STOP,
+        };
+        super::process::signal_group(pid, signal);
+        i.at = Some(Instant::now());
+        i.at_ns = realtime_ns();
+        writeln!(
+            out,
+            "chaos: {:?} {} (pid {pid}) after frame {raw}",
+            i.spec.action, i.spec.instance
+        )?;
+    }
+    Ok(())
+}
+
+/// Fails when an instance is down for good (a finished sensor may exit).
+fn check_failed(sup: &Supervisor) -> Result<()> {
+    for i in &sup.suite.state.instances {
+        if i.status == "failed" {
+            bail!(
+                "service {:?} failed and is not restarted; last lines of {}:\n{}",
+                i.name,
+                i.log.display(),
+                super::process::log_tail(&i.log, 15)
+            );
         }
-        let log = suite.log(&name).unwrap_or_default();
-        bail!(
-            "service {name:?} exited during the run ({status}); last lines of {}:\n{}",
-            log.display(),
-            super::process::log_tail(&log, 15)
-        );
     }
     Ok(())
 }

@@ -79,3 +79,35 @@ pub fn final_table(s: &Summary) -> String {
         num(s.overhead_ms.max, 3),
     )
 }
+
+/// The chaos and swap results, one line each (empty without them).
+pub fn chaos_lines(s: &Summary) -> String {
+    let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
+    let mut text = String::new();
+    for c in &s.chaos {
+        text.push_str(&format!(
+            "chaos {:?} {} @{}: detected by {} after {} ms; restarted (first heartbeat) {} ms after detection; takeover {} ms\n",
+            c.action,
+            c.instance,
+            c.at_frame,
+            if c.detected_by.is_empty() { "-" } else { &c.detected_by },
+            opt(c.detection_ms),
+            opt(c.restart_ms),
+            opt(c.takeover_ms),
+        ));
+    }
+    if let Some(w) = &s.swap {
+        text.push_str(&w.line());
+        text.push('\n');
+    }
+    if !s.chaos.is_empty() || s.swap.is_some() {
+        text.push_str(&format!(
+            "missed poses {}  tracked frames not fused {}  fusion latency ms: median {}  max {}\n",
+            s.missed_poses,
+            s.unfused_tracking_frames,
+            num(s.fusion_latency_ms.median, 1),
+            num(s.fusion_latency_ms.max, 1)
+        ));
+    }
+    text
+}

@@ -1,9 +1,11 @@
 //! Scoring a run: poses against truth, frame by frame, and the summary.
 
+use super::chaos::ChaosReport;
 use crate::eval::stats::{MeanMax, median};
+use crate::suite::swap::SwapReport;
 use serde::Serialize;
-use spacepose_messages::{PoseEstimate, TruthMsg, WireMode, WireStatus, elapsed_ms};
-use std::collections::BTreeMap;
+use spacepose_messages::{FilterState, PoseEstimate, TruthMsg, WireMode, WireStatus, elapsed_ms};
+use std::collections::{BTreeMap, HashMap};
 
 /// One scored frame.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -41,6 +43,10 @@ pub struct Scorer {
     /// Poses that could not be scored (bad quaternion...).
     pub unscorable: u64,
     mode: Option<String>,
+    /// First pose of each frame: (time of validity, cloud published ns, tracking).
+    frames: BTreeMap<u64, (f64, i64, bool)>,
+    /// First filter state published at each time of validity (bits of t_s).
+    fused_ns: HashMap<u64, i64>,
 }
 
 impl Scorer {
@@ -52,6 +58,10 @@ impl Scorer {
 
     /// Records a pose; returns the frames that became scorable.
     pub fn on_pose(&mut self, p: PoseEstimate) -> Vec<FrameScore> {
+        let tracking = p.status == WireStatus::Tracking as u8;
+        self.frames
+            .entry(p.sequence)
+            .or_insert((p.t_s, p.cloud_published_ns, tracking));
         if self.poses.contains_key(&p.sequence) || self.scored.contains_key(&p.sequence) {
             self.duplicate_poses += 1;
             return Vec::new();
@@ -63,6 +73,33 @@ impl Scorer {
         }
         self.poses.insert(p.sequence, p);
         self.try_score(p.sequence)
+    }
+
+    /// Records a filter state (its time of validity is the fused frame's).
+    pub fn on_state(&mut self, s: &FilterState) {
+        if s.initialized != 0 {
+            self.fused_ns
+                .entry(s.t_s.to_bits())
+                .or_insert(s.published_ns);
+        }
+    }
+
+    /// Per frame with a pose: (sequence, cloud published ns, fused state
+    /// published ns if a state at its time was seen).
+    pub fn fusions(&self) -> Vec<(u64, i64, Option<i64>)> {
+        self.frames
+            .iter()
+            .map(|(seq, (t, cloud, _))| (*seq, *cloud, self.fused_ns.get(&t.to_bits()).copied()))
+            .collect()
+    }
+
+    /// Frames whose first pose was `tracking` but no filter state at its
+    /// time was seen (no estimate of the frame was fused).
+    pub fn unfused_tracking_frames(&self) -> u64 {
+        self.frames
+            .values()
+            .filter(|(t, _, tracking)| *tracking && !self.fused_ns.contains_key(&t.to_bits()))
+            .count() as u64
     }
 
     /// Records when a raw frame was published (ns, CLOCK_REALTIME).
@@ -185,6 +222,18 @@ pub struct Summary {
     pub overhead_ms: Spread,
     /// Frames per status (`tracking`, `degraded`, `lost`).
     pub status_counts: BTreeMap<String, usize>,
+    /// Frames tracked (first pose `tracking`) for which the filter published
+    /// no state at their time: no estimate of theirs was fused.
+    pub unfused_tracking_frames: u64,
+    /// Cloud published by ingest → filter state of that frame published
+    /// (ms): includes the wait for the primary up to the frame deadline.
+    pub fusion_latency_ms: Spread,
+    /// Injected faults and what the supervisor did (`--chaos`).
+    pub chaos: Vec<ChaosReport>,
+    /// The run-time swap (`--swap`).
+    pub swap: Option<SwapReport>,
+    /// Restarts per instance by the supervisor.
+    pub restarts: BTreeMap<String, u32>,
     /// Per-frame scores.
     pub series: Vec<FrameScore>,
 }
@@ -223,6 +272,17 @@ impl Summary {
             tracker_latency_ms: Spread::of(&col(|s| s.tracker_latency_ms, 0)),
             overhead_ms: Spread::of(&col(|s| s.overhead_ms, 0)),
             status_counts,
+            unfused_tracking_frames: scorer.unfused_tracking_frames(),
+            fusion_latency_ms: Spread::of(
+                &scorer
+                    .fusions()
+                    .iter()
+                    .filter_map(|(_, cloud, fused)| fused.map(|f| (f - cloud) as f64 * 1e-6))
+                    .collect::<Vec<_>>(),
+            ),
+            chaos: Vec::new(),
+            swap: None,
+            restarts: BTreeMap::new(),
             series,
         }
     }
