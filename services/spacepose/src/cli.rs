@@ -20,6 +20,8 @@ pub struct Cli {
 pub enum Command {
     /// Simulate lidar frames of a scenario and write them with ground truth.
     Sim(SimArgs),
+    /// Generate the synthetic CNN training set (depth images, soft labels) as .npy files.
+    Dataset(crate::dataset_cmd::DatasetArgs),
     /// Evaluate an estimator against ground truth.
     #[command(subcommand)]
     Eval(EvalCommand),

@@ -4,6 +4,7 @@
 
 pub mod cli;
 pub mod common;
+pub mod dataset_cmd;
 pub mod eval;
 pub mod ground;
 pub mod sim_cmd;

@@ -12,6 +12,7 @@ fn main() -> ExitCode {
     init_logging(cli.verbose);
     let result = match cli.command {
         Command::Sim(args) => spacepose::sim_cmd::run(&args),
+        Command::Dataset(args) => spacepose::dataset_cmd::run(&args),
         Command::Eval(EvalCommand::Tracking(args)) => spacepose::eval::tracking::run(&args),
         Command::Up(args) => spacepose::suite::cmd::up(&args),
         Command::Supervise(args) => spacepose::suite::cmd::supervise(&args),
