@@ -1,0 +1,171 @@
+//! The init service's TOML configuration.
+
+use crate::error::InitError;
+use crate::state::InitConfig;
+use serde::{Deserialize, Serialize};
+use spacepose_acquisition::TemplateMatchingConfig;
+use spacepose_lidar_sim::SensorConfig;
+use spacepose_messages::Name;
+
+/// An acquisition method the service can run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MethodKind {
+    /// Seed 002 on-line template matching + ICP + f_CONV check.
+    TemplateMatching,
+    /// Seed 004 CNN (issue 6; not available yet).
+    Cnn,
+}
+
+/// The init service's TOML file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct InitServiceConfig {
+    /// Target: a built-in name (`"deos"`, `"envisat"`) or a mesh file.
+    pub target: String,
+    /// Scale applied to a mesh file.
+    pub target_scale: f64,
+    /// Integration time of the sensor whose scan pattern the templates use
+    /// (s; the Livox Mid-40 model, as lidar-sim).
+    pub integration_time_s: f64,
+    /// Instance name; `--instance` overrides it; default `"init"`.
+    pub instance: Option<String>,
+    /// Methods tried in order on each frame; the first accepted pose wins
+    /// (issue 6 will put the CNN first, template matching as the fallback).
+    pub methods: Vec<MethodKind>,
+    /// A frame with fewer finite points is a failure without trying any
+    /// method (seed 002's sparse-cloud case).
+    pub min_points: usize,
+    /// When to acquire, retry and give up on a hand-over.
+    pub state: InitConfig,
+    /// Template matching, refinement and f_MAX.
+    pub template_matching: TemplateMatchingConfig,
+}
+
+impl Default for InitServiceConfig {
+    fn default() -> Self {
+        Self {
+            target: "deos".into(),
+            target_scale: 1.0,
+            integration_time_s: SensorConfig::MID40_INTEGRATION_TIME_S,
+            instance: None,
+            methods: vec![MethodKind::TemplateMatching],
+            min_points: 20,
+            state: InitConfig::default(),
+            template_matching: TemplateMatchingConfig::default(),
+        }
+    }
+}
+
+impl InitServiceConfig {
+    /// Checks every value (NaN fails) and that every method is available.
+    pub fn validate(&self) -> Result<(), InitError> {
+        let bad = |m: String| Err(InitError::InvalidConfig(m));
+        if self.target.is_empty() {
+            return bad("target must not be empty".into());
+        }
+        if !(self.target_scale.is_finite() && self.target_scale > 0.0) {
+            return bad(format!("target_scale = {} must be > 0", self.target_scale));
+        }
+        if !(self.integration_time_s.is_finite() && self.integration_time_s > 0.0) {
+            return bad(format!(
+                "integration_time_s = {} must be > 0",
+                self.integration_time_s
+            ));
+        }
+        if let Some(instance) = &self.instance {
+            Name::new(instance).map_err(|e| InitError::InvalidConfig(format!("instance: {e}")))?;
+        }
+        if self.methods.is_empty() {
+            return bad("methods must list at least one method".into());
+        }
+        if self.methods.contains(&MethodKind::Cnn) {
+            return bad("method \"cnn\" is not available yet (issue 6)".into());
+        }
+        if self.min_points < 3 {
+            return bad(format!("min_points = {} must be >= 3", self.min_points));
+        }
+        self.state.validate()?;
+        self.template_matching
+            .validate()
+            .map_err(|e| InitError::InvalidConfig(format!("template_matching: {e}")))
+    }
+
+    /// The sensor model the templates are cast with.
+    pub fn sensor(&self) -> SensorConfig {
+        SensorConfig {
+            integration_time_s: self.integration_time_s,
+            ..SensorConfig::livox_mid40()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_round_trip_through_toml() {
+        let c = InitServiceConfig::default();
+        c.validate().unwrap();
+        let text = toml::to_string(&c).unwrap();
+        let back: InitServiceConfig = toml::from_str(&text).unwrap();
+        assert_eq!(back, c);
+    }
+
+    #[test]
+    fn partial_files_take_defaults_and_unknown_keys_fail() {
+        let c: InitServiceConfig =
+            toml::from_str("target = \"deos\"\n[state]\nretry_after_frames = 2\n").unwrap();
+        assert_eq!(c.state.retry_after_frames, 2);
+        assert_eq!(
+            c.state.handover_frames,
+            InitConfig::default().handover_frames
+        );
+        assert!(toml::from_str::<InitServiceConfig>("targett = \"deos\"").is_err());
+        assert!(toml::from_str::<InitServiceConfig>("[state]\nretry = 1").is_err());
+    }
+
+    #[test]
+    fn nan_zero_and_unavailable_values_fail_validation() {
+        let base = InitServiceConfig::default();
+        let mut tm_nan = base.template_matching.clone();
+        tm_nan.f_max_m2 = f64::NAN;
+        for c in [
+            InitServiceConfig {
+                target_scale: f64::NAN,
+                ..base.clone()
+            },
+            InitServiceConfig {
+                integration_time_s: f64::NAN,
+                ..base.clone()
+            },
+            InitServiceConfig {
+                integration_time_s: 0.0,
+                ..base.clone()
+            },
+            InitServiceConfig {
+                methods: vec![],
+                ..base.clone()
+            },
+            InitServiceConfig {
+                methods: vec![MethodKind::Cnn, MethodKind::TemplateMatching],
+                ..base.clone()
+            },
+            InitServiceConfig {
+                min_points: 2,
+                ..base.clone()
+            },
+            InitServiceConfig {
+                instance: Some("bad name!".into()),
+                ..base.clone()
+            },
+            InitServiceConfig {
+                template_matching: tm_nan,
+                ..base.clone()
+            },
+        ] {
+            assert!(c.validate().is_err(), "{c:?}");
+        }
+    }
+}
