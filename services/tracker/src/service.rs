@@ -14,6 +14,7 @@ use crate::output::TrackOutput;
 use crate::status::TrackStatus;
 use crate::tracker::Tracker;
 use crate::wire::{fill_estimate, lost_estimate, mode_from_wire};
+use spacepose_filter::Prediction;
 use spacepose_filter::wire::{acquisition_pose, prediction_from_state};
 use spacepose_geometry::{Point, Pose};
 use spacepose_messages::{
@@ -91,6 +92,12 @@ pub struct TrackerNode {
     /// swapped in) may start from the filter service's state; false once
     /// initialised or told to wait for an acquisition.
     warm_start: bool,
+    /// The filter service's latest state, applied before the first frame
+    /// that starts at or after its time: with redundant trackers a faster
+    /// one's frame is often fused (and its state received) before this
+    /// tracker has processed the same frame, and restoring a state from the
+    /// end of the scan about to be tracked would put the filter after it.
+    pending_state: Option<Prediction>,
 }
 
 impl TrackerNode {
@@ -109,6 +116,7 @@ impl TrackerNode {
             pending: None,
             initialized: false,
             warm_start: true,
+            pending_state: None,
         })
     }
 
@@ -133,26 +141,44 @@ impl TrackerNode {
         Ok(true)
     }
 
-    /// Replaces the local filter with the filter service's state (ignored
-    /// while an initialisation is pending, and for states older than the
-    /// local one). A fresh instance that was never initialised starts from
-    /// it (warm start of a restarted or swapped-in tracker, issue 7).
+    /// Keeps the filter service's state to replace the local filter with
+    /// before the next frame that starts at or after it (ignored while an
+    /// initialisation is pending; states older than the local one are
+    /// ignored when applied). A fresh instance that was never initialised
+    /// starts from it (warm start of a restarted or swapped-in tracker,
+    /// issue 7).
     pub fn on_filter_state(&mut self, s: &FilterState) -> Result<(), TrackError> {
         let prediction = prediction_from_state(s).map_err(|e| invalid("FilterState", e))?;
-        match prediction {
-            Some(p) if self.initialized && self.pending.is_none() => {
-                self.tracker.restore_filter(&p)
-            }
-            Some(p) if self.warm_start && self.pending.is_none() => {
-                self.tracker
-                    .initialize(p.t, &p.pose, p.v_sensor, p.w_target)?;
-                self.tracker.restore_filter(&p)?;
-                self.initialized = true;
-                self.warm_start = false;
-                Ok(())
-            }
-            _ => Ok(()),
+        if let Some(p) = prediction
+            && self.pending.is_none()
+            && (self.initialized || self.warm_start)
+            && self.pending_state.is_none_or(|old| old.t <= p.t)
+        {
+            self.pending_state = Some(p);
         }
+        Ok(())
+    }
+
+    /// Applies the kept filter state when it is not after the scan start.
+    fn apply_filter_state(&mut self, header: &CloudHeader) -> Result<(), TrackError> {
+        let Some(p) = self.pending_state else {
+            return Ok(());
+        };
+        if p.t > header.scan_start_s || self.pending.is_some() {
+            return Ok(());
+        }
+        self.pending_state = None;
+        if self.initialized {
+            return self.tracker.restore_filter(&p);
+        }
+        if self.warm_start {
+            self.tracker
+                .initialize(p.t, &p.pose, p.v_sensor, p.w_target)?;
+            self.tracker.restore_filter(&p)?;
+            self.initialized = true;
+            self.warm_start = false;
+        }
+        Ok(())
     }
 
     /// Applies a command addressed to this instance (or to all).
@@ -178,6 +204,7 @@ impl TrackerNode {
                 self.initialized = false;
                 self.warm_start = false;
                 self.pending = None;
+                self.pending_state = None;
                 Ok(CommandOutcome::ReinitFromAcquisition)
             }
             CommandKind::Swap => Ok(CommandOutcome::Ignored(kind)),
@@ -199,6 +226,10 @@ impl TrackerNode {
                 return result;
             }
         };
+        if let Err(e) = self.apply_filter_state(header) {
+            result.reason = format!("filter state not applied: {e}");
+            result.error = Some(e);
+        }
         let refine_from = match self.apply_pending(header) {
             Ok(pose) => pose,
             Err(e) => {

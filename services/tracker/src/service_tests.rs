@@ -204,7 +204,10 @@ fn filter_states_are_followed_once_tracking() {
     // filter service's state and tracks the next frame.
     let mut fresh = self::node();
     fresh.on_filter_state(&state).unwrap();
-    assert!(fresh.is_tracking());
+    // Not before a frame that starts after the state's time.
+    let r = fresh.on_cloud(&header(1, &f[1]), &f[1].points);
+    assert_eq!(status(&r), WireStatus::Lost);
+    assert!(!fresh.is_tracking());
     let r = fresh.on_cloud(&header(2, &f[2]), &f[2].points);
     assert_eq!(status(&r), WireStatus::Tracking, "{}", r.reason);
     let (ang, _) = errors(&r, &f[2]);
@@ -212,6 +215,7 @@ fn filter_states_are_followed_once_tracking() {
     node.on_acquisition(&truth_acquisition(&f[0])).unwrap();
     node.on_cloud(&header(1, &f[1]), &f[1].points);
     node.on_filter_state(&state).unwrap();
+    node.apply_filter_state(&header(2, &f[2])).unwrap();
     let p = node.tracker().predict_at(f[1].scan_end).unwrap();
     let (ang, pos) = p.pose.error_to(&f[1].truth.t_sensor_target);
     assert!(
