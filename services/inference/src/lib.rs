@@ -8,6 +8,18 @@
 //! (crate feature `ort`, library loaded at run time: nothing is downloaded
 //! at build time). Both run batch 1 on one thread.
 //!
+//! The ort engine loads the ONNX Runtime shared library given in
+//! [`Engine::Ort`]; [`find_ort_library`] finds one in `$ORT_DYLIB_PATH` or in
+//! the training venv's onnxruntime wheel. The path is checked before any ort
+//! call (ort panics on a missing library), and one library is loaded per
+//! process.
+//!
+//! Test fixtures (`fixtures/`) are made without PyTorch by
+//! `fixtures/make_fixture.py` (onnx + onnxruntime); `expected.json` holds
+//! onnxruntime's outputs, which both engines reproduce to 1e-5. Latency:
+//! `cargo bench -p spacepose-inference [--features ort] --bench infer`, on
+//! `$SPACEPOSE_MODEL` (shape from the `model.json` beside it) or the fixture.
+//!
 //! ```no_run
 //! use spacepose_inference::{Engine, ModelShape, PoseNet};
 //! let shape = ModelShape { image_size: 96, classes: 600 };
