@@ -186,3 +186,48 @@ fn roi_keeps_the_whole_target() {
     assert!(max_offset < 1.5);
     let _ = Rotation3::<f64>::identity();
 }
+
+#[test]
+fn cube_seen_edge_on_gives_a_depth_ramp() {
+    // A 1 m cube centred at (0, 0, 10), rotated 45° about y: the sensor sees
+    // two faces meeting at the near vertical edge x = 0, z = 10 − √2/2, and
+    // the depth grows as |x| (45° faces). Sample both faces densely.
+    let r = Rotation3::from_axis_angle(&Vector3::y_axis(), std::f64::consts::FRAC_PI_4);
+    let centre = Vector3::new(0.0, 0.0, 10.0);
+    let mut pts = Vec::new();
+    let n = 200;
+    for i in 0..n {
+        for j in 0..n {
+            let a = -0.5 + (i as f64 + 0.5) / n as f64;
+            let b = -0.5 + (j as f64 + 0.5) / n as f64;
+            // Faces x = +0.5 and z = −0.5 of the body cube face the sensor after R.
+            for body in [Vector3::new(0.5, b, a), Vector3::new(a, b, -0.5)] {
+                pts.push(Point::from_vector(&(r * body + centre), 1.0, 0.0));
+            }
+        }
+    }
+    let img = preprocess(&pts, &config()).unwrap();
+    let c = img.roi_centre;
+    let z_edge = 10.0 - std::f64::consts::FRAC_1_SQRT_2;
+    let mut checked = 0;
+    for row in 0..64 {
+        for col in 0..64 {
+            let v = f64::from(img.pixels[row * 64 + col]);
+            let x = c.x - 2.0 + (col as f64 + 0.5) / 16.0;
+            let y = c.y - 2.0 + (row as f64 + 0.5) / 16.0;
+            let on_cube = x.abs() < std::f64::consts::FRAC_1_SQRT_2 - 0.07 && y.abs() < 0.45;
+            if on_cube {
+                let expected = (z_edge + x.abs() - c.z + 2.0) / 4.0;
+                // Half a pixel of ramp (3.1 cm / 4 m) plus the averaging at the edge.
+                assert!(
+                    (v - expected).abs() < 0.01,
+                    "({row},{col}) {v} vs {expected}"
+                );
+                checked += 1;
+            } else if x.abs() > 0.75 || y.abs() > 0.55 {
+                assert_eq!(v, 0.0, "({row},{col}) must be empty");
+            }
+        }
+    }
+    assert!(checked > 250, "{checked} pixels checked");
+}
