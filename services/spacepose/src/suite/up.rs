@@ -186,7 +186,7 @@ pub fn supervise(path: &Path, overrides: &Overrides) -> Result<()> {
         stdout: Some(std::io::stdout()),
         log,
     };
-    let (bus, watch, suite) = bring_up(&plan, "supervisor", &mut out)?;
+    let (bus, watch, suite) = bring_up(&plan, "sup", &mut out)?;
     let mut sup = super::supervisor::Supervisor::new(plan, bus, watch, suite)?;
     writeln!(out, "{READY}")?;
     out.flush()?;
