@@ -13,7 +13,7 @@ use std::process::{Command, Output, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Every binary a full suite needs.
-pub const SUITE_BINARIES: [&str; 7] = [
+pub const SUITE_BINARIES: [&str; 8] = [
     "spacepose",
     "spacepose-lidar-sim",
     "spacepose-pcd-replay",
@@ -21,6 +21,7 @@ pub const SUITE_BINARIES: [&str; 7] = [
     "spacepose-tracker",
     "spacepose-filter",
     "spacepose-telemetry",
+    "spacepose-init",
 ];
 
 /// `target/release/` (the directory of the binaries), from the test

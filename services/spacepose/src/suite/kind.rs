@@ -20,17 +20,20 @@ pub enum ServiceKind {
     Filter,
     /// Health, pose and truth to zenoh JSON (`spacepose-telemetry`).
     Telemetry,
+    /// Pose acquisition at start and after a loss (`spacepose-init`).
+    Init,
 }
 
 impl ServiceKind {
     /// Every kind.
-    pub const ALL: [ServiceKind; 6] = [
+    pub const ALL: [ServiceKind; 7] = [
         ServiceKind::LidarSim,
         ServiceKind::PcdReplay,
         ServiceKind::Ingest,
         ServiceKind::Tracker,
         ServiceKind::Filter,
         ServiceKind::Telemetry,
+        ServiceKind::Init,
     ];
 
     /// The descriptor spelling (`"lidar-sim"`, ...).
@@ -42,6 +45,7 @@ impl ServiceKind {
             ServiceKind::Tracker => "tracker",
             ServiceKind::Filter => "filter",
             ServiceKind::Telemetry => "telemetry",
+            ServiceKind::Init => "init",
         }
     }
 
@@ -67,11 +71,12 @@ impl ServiceKind {
         match self {
             ServiceKind::LidarSim | ServiceKind::PcdReplay => &[],
             ServiceKind::Ingest => &[Topic::RawCloud],
-            // Until the init service exists (issue 5), the first pose comes
-            // from lidar-sim's truth acquisition (`truth_init = true`).
+            // The first pose comes from the init service (or, the old
+            // documented path, lidar-sim's `truth_init = true`).
             ServiceKind::Tracker => &[Topic::Cloud, Topic::Acquisition],
             ServiceKind::Filter => &[Topic::Pose],
             ServiceKind::Telemetry => &[Topic::Health],
+            ServiceKind::Init => &[Topic::Cloud],
         }
     }
 
@@ -83,6 +88,8 @@ impl ServiceKind {
             ServiceKind::Tracker => &[Topic::FilterState, Topic::Command],
             ServiceKind::Filter => &[Topic::Acquisition, Topic::Command],
             ServiceKind::Telemetry => &[Topic::Pose, Topic::FilterState, Topic::Truth],
+            // Without tracker poses it acquires once and never hears of a loss.
+            ServiceKind::Init => &[Topic::Pose],
         }
     }
 
@@ -97,6 +104,7 @@ impl ServiceKind {
             ServiceKind::Filter => vec![Topic::FilterState],
             // JSON on zenoh only (no inbound command route yet).
             ServiceKind::Telemetry => vec![],
+            ServiceKind::Init => vec![Topic::Acquisition],
         };
         if self == ServiceKind::LidarSim && truth_init {
             out.push(Topic::Acquisition);
@@ -148,6 +156,17 @@ mod tests {
                 .outputs(true)
                 .contains(&Topic::Acquisition)
         );
+    }
+
+    #[test]
+    fn the_init_service_feeds_the_tracker_without_truth() {
+        assert!(ServiceKind::producers_of(Topic::Acquisition).contains(&ServiceKind::Init));
+        assert_eq!(
+            ServiceKind::Init.outputs(false),
+            vec![Topic::Acquisition, Topic::Health]
+        );
+        assert_eq!(ServiceKind::Init.required_inputs(), &[Topic::Cloud]);
+        assert_eq!(ServiceKind::Init.binary_name(), "spacepose-init");
     }
 
     #[test]
