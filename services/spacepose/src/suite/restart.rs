@@ -171,11 +171,12 @@ mod tests {
             ]
         );
         assert_eq!(h.total, 3);
-        // Once the first restarts leave the window, restarts resume.
+        // Once the first restarts leave the window, restarts resume, with
+        // the backoff of the one still inside it (at 2 s).
         let later = t0 + Duration::from_secs(12);
         assert_eq!(
             h.decide(&s, Policy::OnFailure, &Stop::Hung, later),
-            Decision::RestartAfter(ms(250))
+            Decision::RestartAfter(ms(200))
         );
     }
 
