@@ -260,3 +260,38 @@ fn an_acquisition_at_its_own_scan_end_does_not_freeze_the_spin() {
     let last = &errors_deg[10..];
     assert!(last.iter().all(|&e| e < 3.0), "{errors_deg:.1?}");
 }
+
+#[test]
+fn after_a_loss_an_accepted_acquisition_restarts_the_track_and_a_rejected_one_does_not() {
+    let f = &fixture().frames;
+    let mut config = TrackerConfig::with_mode(TrackingMode::Ndt);
+    config.loss.max_consecutive_degraded = 1;
+    let instance = Name::new("tracker-t").unwrap();
+    let mut node = TrackerNode::new(config, fixture().model.clone(), instance, 150_000).unwrap();
+    node.on_acquisition(&truth_acquisition(&f[0])).unwrap();
+    let r = node.on_cloud(&header(0, &f[0]), &f[0].points);
+    assert_eq!(status(&r), WireStatus::Tracking, "{}", r.reason);
+    // Frame 1 seen 3 m to the side: inconsistent with the prediction, and
+    // with one degraded frame allowed, the track is lost.
+    let shifted: Vec<Point> = f[1]
+        .points
+        .iter()
+        .map(|p| Point { x: p.x + 3.0, ..*p })
+        .collect();
+    let r = node.on_cloud(&header(1, &f[1]), &shifted);
+    assert_eq!(status(&r), WireStatus::Lost, "{}", r.reason);
+    assert!(!node.is_tracking());
+    // A rejected result (the init service's f_CONV check) changes nothing.
+    let mut rejected = truth_acquisition(&f[1]);
+    rejected.success = 0;
+    assert!(!node.on_acquisition(&rejected).unwrap());
+    let r = node.on_cloud(&header(2, &f[2]), &f[2].points);
+    assert_eq!(status(&r), WireStatus::Lost, "{}", r.reason);
+    // The accepted reacquisition from frame 2 restarts the track on frame 3.
+    assert!(node.on_acquisition(&truth_acquisition(&f[2])).unwrap());
+    let r = node.on_cloud(&header(3, &f[3]), &f[3].points);
+    assert_eq!(status(&r), WireStatus::Tracking, "{}", r.reason);
+    let (ang, pos) = errors(&r, &f[3]);
+    assert!(ang < 1.0 && pos < 0.05, "{ang}° {pos} m");
+    assert!(node.is_tracking());
+}
