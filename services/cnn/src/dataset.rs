@@ -69,6 +69,19 @@ pub struct Sample {
     pub redraws: u32,
 }
 
+/// One simulated frame of the set, before it becomes a [`Sample`].
+#[derive(Debug, Clone)]
+pub struct GeneratedFrame {
+    /// The cloud (sensor frame, scan order), every sensor effect applied.
+    pub points: Vec<spacepose_geometry::Point>,
+    /// Truth at scan end.
+    pub truth: spacepose_scenario::TruthState,
+    /// The depth image of `points` (§III.A).
+    pub image: crate::preprocess::DepthImage,
+    /// Frames re-drawn before this one was accepted.
+    pub redraws: u32,
+}
+
 /// Statistics of a generated set.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct DatasetStats {
@@ -134,6 +147,29 @@ impl Generator {
     /// # Errors
     /// [`CnnError::TooManyRedraws`], or a simulator / preprocessing error.
     pub fn sample(&self, index: u64) -> Result<Sample, CnnError> {
+        let f = self.frame(index)?;
+        let t = &f.truth.t_sensor_target;
+        let offset = t.translation - f.image.roi_centre;
+        let mut labels = vec![0.0; self.classes.len()];
+        soft_labels_into(&self.classes, &t.rotation, &mut labels);
+        Ok(Sample {
+            depth: f.image.pixels,
+            labels,
+            pos_offset: [offset.x as f32, offset.y as f32, offset.z as f32],
+            attitude: quaternion_wxyz(&t.rotation),
+            range_m: t.translation.norm() as f32,
+            points_in_roi: f.image.points_in_roi,
+            redraws: f.redraws,
+        })
+    }
+
+    /// The simulated frame behind sample `index` (the cloud, its truth and
+    /// its depth image), re-drawn exactly as [`Generator::sample`] does: a
+    /// held-out evaluation set is `frame(i)` for a seed never trained on.
+    ///
+    /// # Errors
+    /// [`CnnError::TooManyRedraws`], or a simulator / preprocessing error.
+    pub fn frame(&self, index: u64) -> Result<GeneratedFrame, CnnError> {
         let mut rng = LidarSimulator::frame_rng(self.config.seed, index);
         let half = 0.5 * self.preprocess.roi_side_m;
         for attempt in 0..MAX_ATTEMPTS {
@@ -150,19 +186,10 @@ impl Generator {
             if image.points_in_roi < self.config.min_points || offset.amax() >= half {
                 continue;
             }
-            let mut labels = vec![0.0; self.classes.len()];
-            soft_labels_into(
-                &self.classes,
-                &draw.truth.t_sensor_target.rotation,
-                &mut labels,
-            );
-            return Ok(Sample {
-                depth: image.pixels,
-                labels,
-                pos_offset: [offset.x as f32, offset.y as f32, offset.z as f32],
-                attitude: quaternion_wxyz(&draw.truth.t_sensor_target.rotation),
-                range_m: draw.truth.t_sensor_target.translation.norm() as f32,
-                points_in_roi: image.points_in_roi,
+            return Ok(GeneratedFrame {
+                points: frame.points,
+                truth: draw.truth,
+                image,
                 redraws: attempt,
             });
         }

@@ -91,6 +91,69 @@ pub enum CnnError {
     /// Serialising the dataset metadata failed.
     #[error("meta.json: {0}")]
     Json(#[from] serde_json::Error),
+
+    /// A model directory is missing or lacks `model.onnx` / `model.json`.
+    #[error("model directory {}: {reason}", path.display())]
+    ModelDir {
+        /// The directory.
+        path: PathBuf,
+        /// What is missing.
+        reason: String,
+    },
+
+    /// `model.json` cannot be parsed.
+    #[error("{}: bad model metadata: {reason}", path.display())]
+    ModelMeta {
+        /// The file.
+        path: PathBuf,
+        /// The parser's message.
+        reason: String,
+    },
+
+    /// The model was trained for another preprocessing or class table.
+    #[error(
+        "{}: the model was trained with {field} = {model}, this build expects {expected} \
+         (retrain the model or use the matching configuration)",
+        path.display()
+    )]
+    ModelMismatch {
+        /// The model directory.
+        path: PathBuf,
+        /// The field that differs.
+        field: &'static str,
+        /// The model's value.
+        model: String,
+        /// The value in use here.
+        expected: String,
+    },
+
+    /// Loading or running the network failed.
+    #[error("network: {0}")]
+    Inference(#[from] spacepose_inference::InferenceError),
+
+    /// Building or loading the NDT map or the ICP model failed.
+    #[error("refinement model: {0}")]
+    Registration(#[from] spacepose_registration::RegistrationError),
+
+    /// The target named by the model cannot be resolved.
+    #[error("target {name:?}: {reason}")]
+    Target {
+        /// The target name.
+        name: String,
+        /// Why it cannot be used.
+        reason: String,
+    },
+
+    /// The cloud has too few finite points to estimate a pose.
+    #[error("{valid} finite points of {total}, at least {required} needed")]
+    TooFewPoints {
+        /// Finite points.
+        valid: usize,
+        /// Points given.
+        total: usize,
+        /// Minimum required.
+        required: usize,
+    },
 }
 
 /// Shorthand for an I/O error on `path`.

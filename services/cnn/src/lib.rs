@@ -2,7 +2,8 @@
 //! preprocessing (§III.A), attitude classes with symmetry reduction
 //! (§III.C.1, §III.C.4), soft labels `L_sym` (Eq. 15), decoding `Γ_sym`
 //! (Algorithm 1), and the synthetic dataset generator (§IV.B) with its
-//! `.npy` writer. A library only: no bus.
+//! `.npy` writer, and the estimator ([`CnnEstimator`]: network, decoding,
+//! NDT refinement §III.E and the f_CONV check). A library only: no bus.
 //!
 //! ```no_run
 //! # fn demo(cloud: &[spacepose_geometry::Point]) -> Result<(), spacepose_cnn::CnnError> {
@@ -21,13 +22,20 @@ pub mod dataset;
 pub mod decode;
 pub mod domain;
 pub mod error;
+pub mod estimator;
 pub mod labels;
+pub mod model_meta;
 pub mod npy;
 pub mod preprocess;
+pub mod refinement;
 
 pub use classes::{ClassTable, DEFAULT_ROLL_STEP_DEG};
-pub use dataset::{DEFAULT_MIN_POINTS, DatasetConfig, DatasetStats, Generator, Sample};
+pub use dataset::{
+    DEFAULT_MIN_POINTS, DatasetConfig, DatasetStats, GeneratedFrame, Generator, Sample,
+};
 pub use decode::{DEFAULT_DELTA_BETA_DEG, decode};
 pub use error::CnnError;
+pub use estimator::{CnnEstimate, CnnEstimator, EstimatorConfig, Timings};
 pub use labels::soft_labels;
 pub use preprocess::{DEFAULT_IMAGE_SIZE, DepthImage, PreprocessConfig, preprocess, roi_side_for};
+pub use refinement::{RefinementConfig, Refiner};

@@ -1,0 +1,256 @@
+//! Refinement of the CNN estimate (seed 004 §III.E): the smoothed NDT of
+//! seed 000 §3.1 from the network's pose, on the cloud voxel-filtered at
+//! 2 cm (§V.B), then the f_CONV failure check of seed 002 §4.5.
+//!
+//! f_CONV is the figure of the acquisition crate (`spacepose-acquisition`,
+//! `refine`): `Registration::f_conv_m2` of a point-to-point ICP
+//! (`register_icp`, `IcpParams::default()`, the final stage of template
+//! matching) run to convergence, here from the NDT pose: the mean squared
+//! distance of every point to the nearest model point, without any
+//! distance cut. The pose is accepted when `f_CONV <= f_MAX`.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use spacepose_geometry::voxel::VoxelFilter;
+use spacepose_geometry::{Point, Pose};
+use spacepose_registration::{
+    IcpModel, IcpParams, NdtMap, NdtMapParams, NdtParams, RegistrationError, register_icp,
+    register_ndt,
+};
+use spacepose_target::Target;
+
+use crate::error::CnnError;
+
+/// How the CNN estimate is refined and checked.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RefinementConfig {
+    /// Voxel filter before NDT (m): 2 cm in seed 004 §V.B.
+    pub voxel_m: f64,
+    /// Wider NDT stages (maximum point-to-cell distance, m) run before the
+    /// final one, to widen the basin around the network's estimate (not in
+    /// the paper, whose single stage uses 7.5 cm).
+    pub ndt_stages_m: Vec<f64>,
+    /// Iteration limit of each wider stage.
+    pub ndt_stage_iterations: usize,
+    /// The final NDT stage: 7.5 cm, 1 mm / 0.05°, 30 iterations (§V.B).
+    pub ndt: NdtParams,
+    /// The NDT map (cell size 7.5 cm, §V.B).
+    pub map: NdtMapParams,
+    /// Spacing of the model cloud sampled on the target mesh (m).
+    pub model_spacing_m: f64,
+    /// Seed of that sampling.
+    pub model_seed: u64,
+    /// Optional NDT map file: loaded when present (its parameters must match
+    /// `map`), else built and saved there.
+    pub map_file: Option<PathBuf>,
+    /// The ICP whose cost at convergence is f_CONV (seed 002 §4.5).
+    pub icp: IcpParams,
+    /// f_MAX (m²): the estimate is accepted when `f_CONV <= f_MAX`.
+    pub f_max_m2: f64,
+}
+
+impl Default for RefinementConfig {
+    fn default() -> Self {
+        Self {
+            voxel_m: 0.02,
+            ndt_stages_m: vec![0.3, 0.15],
+            ndt_stage_iterations: 10,
+            ndt: NdtParams {
+                max_iterations: 30,
+                ..NdtParams::default()
+            },
+            map: NdtMapParams::default(),
+            model_spacing_m: 0.015,
+            model_seed: 0,
+            map_file: None,
+            icp: IcpParams::default(),
+            f_max_m2: DEFAULT_F_MAX_M2,
+        }
+    }
+}
+
+/// Default f_MAX (m²), from `spacepose eval cnn` on held-out frames (see
+/// the crate README): successes stay below it, most failures above.
+pub const DEFAULT_F_MAX_M2: f64 = 0.02;
+
+impl RefinementConfig {
+    /// Rejects NaN, infinite and non-positive values.
+    ///
+    /// # Errors
+    /// [`CnnError::InvalidParameter`] or [`CnnError::Registration`].
+    pub fn validate(&self) -> Result<(), CnnError> {
+        let positive = |name: &'static str, value: f64| {
+            if value.is_finite() && value > 0.0 {
+                Ok(())
+            } else {
+                Err(CnnError::InvalidParameter { name, value })
+            }
+        };
+        positive("voxel_m", self.voxel_m)?;
+        positive("model_spacing_m", self.model_spacing_m)?;
+        positive("f_max_m2", self.f_max_m2)?;
+        for &d in &self.ndt_stages_m {
+            positive("ndt_stages_m", d)?;
+        }
+        if self.ndt_stage_iterations == 0 {
+            return Err(CnnError::InvalidParameter {
+                name: "ndt_stage_iterations",
+                value: 0.0,
+            });
+        }
+        self.ndt.validate()?;
+        self.map.validate()?;
+        self.icp.validate()?;
+        Ok(())
+    }
+}
+
+/// The refined pose and the figures of the failure check.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Refined {
+    /// NDT pose (target body → sensor).
+    pub t_sensor_target: Pose,
+    /// f_CONV (m²); infinite when the ICP failed.
+    pub f_conv_m2: f64,
+    /// Gauss-Newton iterations over every NDT stage.
+    pub ndt_iterations: usize,
+    /// The final NDT stage converged.
+    pub ndt_converged: bool,
+    /// Inlier fraction of the final NDT stage.
+    pub ndt_inlier_fraction: f64,
+    /// Points after the voxel filter.
+    pub points: usize,
+    /// Time of the voxel filter and NDT (ms).
+    pub ndt_ms: f64,
+    /// Time of the f_CONV ICP (ms).
+    pub fconv_ms: f64,
+}
+
+/// The NDT map and ICP model of one target, built (or loaded) once.
+#[derive(Debug)]
+pub struct Refiner {
+    config: RefinementConfig,
+    map: NdtMap,
+    icp_model: IcpModel,
+    voxel: std::sync::Mutex<VoxelFilter>,
+}
+
+impl Refiner {
+    /// Samples the target's surface, builds the ICP model and builds or
+    /// loads the NDT map.
+    ///
+    /// # Errors
+    /// Invalid configuration, a map file built with other parameters, or a
+    /// model the registration crate refuses.
+    pub fn new(target: &Target, config: RefinementConfig) -> Result<Self, CnnError> {
+        config.validate()?;
+        let model = target.sample_surface(config.model_spacing_m, config.model_seed);
+        let icp_model = IcpModel::new(&model)?;
+        let map = match &config.map_file {
+            Some(path) if path.exists() => load_map(path, &config.map)?,
+            Some(path) => {
+                let map = NdtMap::build(&model, &config.map)?;
+                map.save(path)?;
+                map
+            }
+            None => NdtMap::build(&model, &config.map)?,
+        };
+        let voxel = std::sync::Mutex::new(VoxelFilter::new(config.voxel_m)?);
+        Ok(Self {
+            config,
+            map,
+            icp_model,
+            voxel,
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &RefinementConfig {
+        &self.config
+    }
+
+    /// Sets f_MAX (m²).
+    pub fn set_f_max_m2(&mut self, f_max_m2: f64) {
+        self.config.f_max_m2 = f_max_m2;
+    }
+
+    /// Refines `t_sensor_target` on `cloud` (finite points, sensor frame).
+    ///
+    /// # Errors
+    /// A registration error (no correspondence, degenerate system): the
+    /// estimate cannot be refined and must not be used.
+    pub fn refine(&self, cloud: &[Point], t_sensor_target: &Pose) -> Result<Refined, CnnError> {
+        let start = std::time::Instant::now();
+        let points = {
+            let mut voxel = self
+                .voxel
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            voxel.filter(cloud)?.points
+        };
+        let c = &self.config;
+        let mut t_target_sensor = t_sensor_target.inverse();
+        let mut iterations = 0;
+        for &d in &c.ndt_stages_m {
+            let params = NdtParams {
+                max_distance_m: d,
+                max_iterations: c.ndt_stage_iterations,
+                ..c.ndt
+            };
+            let r = register_ndt(&self.map, &points, &t_target_sensor, &params)?;
+            iterations += r.iterations;
+            t_target_sensor = r.t_target_sensor;
+        }
+        let ndt = register_ndt(&self.map, &points, &t_target_sensor, &c.ndt)?;
+        let ndt_ms = ms(start);
+        let start = std::time::Instant::now();
+        let f_conv_m2 = f_conv(&self.icp_model, &points, &ndt.t_target_sensor, &c.icp);
+        Ok(Refined {
+            t_sensor_target: ndt.t_sensor_target(),
+            f_conv_m2,
+            ndt_iterations: iterations + ndt.iterations,
+            ndt_converged: ndt.converged,
+            ndt_inlier_fraction: ndt.inlier_fraction(),
+            points: points.len(),
+            ndt_ms,
+            fconv_ms: ms(start),
+        })
+    }
+
+    /// The failure check of seed 002 §4.5.
+    pub fn accepts(&self, f_conv_m2: f64) -> bool {
+        f_conv_m2 <= self.config.f_max_m2
+    }
+}
+
+/// f_CONV of an ICP run to convergence from `t_target_sensor`; infinite
+/// when the ICP fails (no pair within its distance, degenerate pairs).
+fn f_conv(model: &IcpModel, points: &[Point], t_target_sensor: &Pose, icp: &IcpParams) -> f64 {
+    register_icp(model, points, t_target_sensor, icp)
+        .ok()
+        .and_then(|r| r.f_conv_m2)
+        .unwrap_or(f64::INFINITY)
+}
+
+fn load_map(path: &Path, params: &NdtMapParams) -> Result<NdtMap, CnnError> {
+    let map = NdtMap::load(path)?;
+    if map.params() != params {
+        return Err(CnnError::Registration(
+            RegistrationError::InvalidParameter {
+                name: "map_file",
+                reason: format!(
+                    "{} was built with other map parameters (delete it to rebuild)",
+                    path.display()
+                ),
+            },
+        ));
+    }
+    Ok(map)
+}
+
+/// Milliseconds since `start`.
+pub(crate) fn ms(start: std::time::Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1e3
+}
