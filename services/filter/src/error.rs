@@ -50,4 +50,13 @@ pub enum FilterError {
         /// Why.
         reason: String,
     },
+    /// The state snapshot file could not be written or read back (I/O,
+    /// or bytes the codec refuses).
+    #[error("filter snapshot {path}: {reason}")]
+    Snapshot {
+        /// The snapshot file.
+        path: std::path::PathBuf,
+        /// Why.
+        reason: String,
+    },
 }

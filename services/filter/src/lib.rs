@@ -11,7 +11,8 @@
 //!   (Eq. 12).
 //! - [`wire`]: conversions to and from the suite's messages (`FilterState`,
 //!   `PoseEstimate`, `AcquisitionResult`); [`selector`]: one estimate per
-//!   frame (primary/standby with a per-frame deadline); [`service`]: the logic of the `spacepose-filter` binary, bus-free.
+//!   frame (primary/standby with a per-frame deadline); [`service`]: the logic of the `spacepose-filter` binary, bus-free;
+//!   [`snapshot`]: the state persisted for a restarted filter service.
 //!
 //! Units SI. `R = r_sensor_target` (target body → sensor), `p = p_sensor` the
 //! target origin in the sensor frame, `v_sensor = dp/dt` in the sensor frame,
@@ -27,7 +28,11 @@ pub mod motion_compensation;
 pub mod position;
 pub mod selector;
 pub mod service;
+pub mod snapshot;
 pub mod wire;
+
+#[cfg(test)]
+mod restart_tests;
 
 pub use attitude::AttitudeFilter;
 pub use config::FilterConfig;

@@ -12,7 +12,10 @@ use anyhow::Context;
 use clap::Parser;
 use serde::Deserialize;
 use spacepose_bus::{Bus, Publisher, Subscriber, WakeReason};
-use spacepose_filter::{FilterError, FilterNode, FilterServiceConfig, Fusion, Reason};
+use spacepose_filter::snapshot::{load_snapshot, save_snapshot};
+use spacepose_filter::{
+    EstimateOutcome, FilterError, FilterNode, FilterServiceConfig, Fusion, Reason,
+};
 use spacepose_messages::{
     AcquisitionResult, Command, CommandKind, FilterState, Names, PoseEstimate, ServiceState,
     realtime_ns,
@@ -76,9 +79,13 @@ fn run(args: ServiceArgs) -> anyhow::Result<()> {
     waiter.attach(&ports.commands)?;
     let mut node = FilterNode::new(&config)?;
     let mut counters = Counters::default();
+    let resumed = resume(&config, &mut node, &mut counters);
     let state_period =
         (config.state_period_ms > 0).then(|| Duration::from_millis(config.state_period_ms));
     let mut last_state = Instant::now();
+    if resumed {
+        publish(&ports, &node, &mut counters);
+    }
     tracing::info!(prefix = names.prefix(), instance, primary = ?node.primary(), "filter service running");
     while !shutdown.load(Ordering::Relaxed) {
         let mut timeout = state_period.map_or(heartbeat, |p| p.min(heartbeat));
@@ -98,6 +105,9 @@ fn run(args: ServiceArgs) -> anyhow::Result<()> {
             publish(&ports, &node, &mut counters);
             last_state = Instant::now();
         }
+        if changed {
+            persist(&config, &node, &mut counters);
+        }
         let state = if node.filter().is_initialized() {
             ServiceState::Running
         } else {
@@ -108,6 +118,43 @@ fn run(args: ServiceArgs) -> anyhow::Result<()> {
     tracing::info!("filter service stopping");
     health.send(&counters, ServiceState::Stopping as u8)?;
     Ok(())
+}
+
+/// Restores the state of a previous filter process from a fresh snapshot
+/// (`snapshot_file`); returns whether it did. A bad snapshot is logged,
+/// counted and ignored.
+fn resume(config: &FilterServiceConfig, node: &mut FilterNode, counters: &mut Counters) -> bool {
+    let Some(path) = &config.snapshot_file else {
+        return false;
+    };
+    let max_age = Duration::from_secs_f64(config.snapshot_max_age_s);
+    let restored = load_snapshot(path, max_age).and_then(|s| match s {
+        Some(s) => node.restore(&s).map(|ok| ok.then_some(s.t_s)),
+        None => Ok(None),
+    });
+    match restored {
+        Ok(Some(t_s)) => {
+            tracing::info!(path = %path.display(), t_s, "resumed from the previous filter's snapshot");
+            true
+        }
+        Ok(None) => false,
+        Err(e) => {
+            counters.errors += 1;
+            tracing::warn!("snapshot ignored: {e}");
+            false
+        }
+    }
+}
+
+/// Writes the state to `snapshot_file` (if configured).
+fn persist(config: &FilterServiceConfig, node: &FilterNode, counters: &mut Counters) {
+    if let Some(path) = &config.snapshot_file
+        && node.filter().is_initialized()
+        && let Err(e) = save_snapshot(path, &node.state())
+    {
+        counters.errors += 1;
+        tracing::warn!("{e}");
+    }
 }
 
 fn publish(ports: &Ports, node: &FilterNode, counters: &mut Counters) {
@@ -198,6 +245,13 @@ fn report(fusions: Vec<Fusion>, counters: &mut Counters) -> bool {
             tracing::info!(sequence = f.sequence, instance = f.instance, reason = ?f.reason, "standby estimate taken");
         }
         match &f.outcome {
+            Ok(EstimateOutcome::InitializedFromEstimate) => {
+                tracing::info!(
+                    sequence = f.sequence,
+                    instance = f.instance,
+                    "initialised from a tracking estimate"
+                );
+            }
             Ok(o) if !o.changed_state() => {
                 tracing::debug!(sequence = f.sequence, outcome = ?o, "estimate not fused");
             }

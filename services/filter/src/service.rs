@@ -6,7 +6,10 @@ use crate::config::FilterConfig;
 use crate::error::FilterError;
 use crate::filter::RelativeMotionFilter;
 use crate::selector::{Candidate, Choice, FrameSelector, Offer, Quality, Reason};
-use crate::wire::{Measurement, acquisition_pose, measurement_from_estimate, state_of, zero_rates};
+use crate::wire::{
+    Measurement, acquisition_pose, measurement_from_estimate, prediction_from_state, state_of,
+    zero_rates,
+};
 use serde::{Deserialize, Serialize};
 use spacepose_messages::{AcquisitionResult, FilterState, PoseEstimate, WireStatus};
 
@@ -37,6 +40,18 @@ pub struct FilterServiceConfig {
     pub max_disagreement_deg: f64,
     /// Same, on the position (m).
     pub max_disagreement_m: f64,
+    /// File the state is persisted to after every change, and restored
+    /// from at start when fresh (a restarted filter resumes with its
+    /// predecessor's pose, rates and covariances). `spacepose up` sets
+    /// `{run dir}/{instance}.filterstate`. None: no snapshot.
+    pub snapshot_file: Option<std::path::PathBuf>,
+    /// A snapshot written longer ago than this (s, wall clock) is ignored.
+    pub snapshot_max_age_s: f64,
+    /// When uninitialised (no fresh snapshot, no acquisition yet), start
+    /// from the first `tracking` estimate the selector chooses, with zero
+    /// rates and the initial covariance of `filter` (as an acquisition
+    /// does, seed 000 §5.2), instead of waiting for the next acquisition.
+    pub init_from_tracking: bool,
 }
 
 impl Default for FilterServiceConfig {
@@ -52,6 +67,9 @@ impl Default for FilterServiceConfig {
             frame_deadline_ms: 100.0,
             max_disagreement_deg: 10.0,
             max_disagreement_m: 0.5,
+            snapshot_file: None,
+            snapshot_max_age_s: 10.0,
+            init_from_tracking: true,
         }
     }
 }
@@ -69,6 +87,7 @@ impl FilterServiceConfig {
             ("frame_deadline_ms", self.frame_deadline_ms),
             ("max_disagreement_deg", self.max_disagreement_deg),
             ("max_disagreement_m", self.max_disagreement_m),
+            ("snapshot_max_age_s", self.snapshot_max_age_s),
         ];
         for (name, v) in positive {
             if !(v.is_finite() && v > 0.0) {
@@ -103,8 +122,12 @@ pub enum EstimateOutcome {
     },
     /// Not a `tracking` estimate: reported, not fused (as in the tracker).
     NotTracking(WireStatus),
-    /// The filter has not been initialised by an acquisition yet.
+    /// The filter has not been initialised by an acquisition yet (and
+    /// `init_from_tracking` is off).
     NotInitialized,
+    /// The filter was uninitialised (e.g. just restarted): this `tracking`
+    /// estimate initialised it, with zero rates and a wide covariance.
+    InitializedFromEstimate,
     /// At or before the time of the current state (and not the initial frame).
     TooOld {
         /// `t_estimate - t_filter` (s).
@@ -115,7 +138,10 @@ pub enum EstimateOutcome {
 impl EstimateOutcome {
     /// True when the state changed and should be published.
     pub fn changed_state(self) -> bool {
-        matches!(self, Self::Fused | Self::Reinitialized)
+        matches!(
+            self,
+            Self::Fused | Self::Reinitialized | Self::InitializedFromEstimate
+        )
     }
 }
 
@@ -149,6 +175,7 @@ pub struct FilterNode {
     updates: u64,
     /// Time of the last (re)initialisation while no estimate has been fused since.
     fresh_init_t: Option<f64>,
+    init_from_tracking: bool,
 }
 
 impl FilterNode {
@@ -166,6 +193,7 @@ impl FilterNode {
             max_disagreement_m: config.max_disagreement_m,
             updates: 0,
             fresh_init_t: None,
+            init_from_tracking: config.init_from_tracking,
         })
     }
 
@@ -195,6 +223,20 @@ impl FilterNode {
         self.selector.reset();
         self.fresh_init_t = Some(t);
         self.updates += 1;
+        Ok(true)
+    }
+
+    /// Resumes from a persisted state (a snapshot of the previous filter
+    /// process, see [`crate::snapshot`]): pose, rates and covariances at
+    /// its time. Returns false for an uninitialised state (nothing to
+    /// resume); errors on a bad one (the node is unchanged then).
+    pub fn restore(&mut self, s: &FilterState) -> Result<bool, FilterError> {
+        let Some(p) = prediction_from_state(s)? else {
+            return Ok(false);
+        };
+        self.filter.restore(&p)?;
+        self.fresh_init_t = None;
+        self.updates = self.updates.max(s.sequence) + 1;
         Ok(true)
     }
 
@@ -285,7 +327,15 @@ impl FilterNode {
             return Ok(EstimateOutcome::NotTracking(m.status));
         }
         let Some(t_filter) = self.filter.time() else {
-            return Ok(EstimateOutcome::NotInitialized);
+            if !self.init_from_tracking {
+                return Ok(EstimateOutcome::NotInitialized);
+            }
+            // A restarted filter without a snapshot: the trackers kept
+            // tracking on their local filters; resume from their pose.
+            let (v, w) = zero_rates();
+            self.filter.initialize(m.t, &m.t_sensor_target, v, w)?;
+            self.updates += 1;
+            return Ok(EstimateOutcome::InitializedFromEstimate);
         };
         if m.t <= t_filter {
             // The acquisition's own frame (or one before it) tracked by the
@@ -361,7 +411,11 @@ mod tests {
 
     #[test]
     fn acquisition_then_tracking_estimates_are_fused() {
-        let mut node = FilterNode::new(&FilterServiceConfig::default()).unwrap();
+        let config = FilterServiceConfig {
+            init_from_tracking: false,
+            ..FilterServiceConfig::default()
+        };
+        let mut node = FilterNode::new(&config).unwrap();
         assert_eq!(node.state().initialized, 0);
         let e1 = estimate(1, 1.0, WireStatus::Tracking);
         assert_eq!(fused(&mut node, &e1), EstimateOutcome::NotInitialized);
