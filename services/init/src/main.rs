@@ -9,6 +9,7 @@ use clap::Parser;
 use serde::Deserialize;
 use spacepose_bus::{Bus, CloudSubscriber, Publisher, Subscriber, WakeReason};
 use spacepose_geometry::Point;
+use spacepose_init::Acquisition;
 use spacepose_init::{EstimateInfo, Event, InitServiceConfig, InitStateMachine, MethodChain};
 use spacepose_messages::clock::realtime_ns;
 use spacepose_messages::{AcquisitionResult, Name, Names, PoseEstimate, ServiceState};
@@ -17,6 +18,7 @@ use spacepose_service_kit::{
 };
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
+use std::sync::mpsc::{Receiver, Sender, channel};
 use std::time::{Duration, Instant};
 
 const SERVICE: &str = "init";
@@ -56,11 +58,47 @@ struct Held {
     points: Vec<Point>,
 }
 
+/// A finished acquisition from the worker thread.
+struct Done {
+    sequence: u64,
+    scan_end_s: f64,
+    points_in: usize,
+    acquisition: Acquisition,
+}
+
+/// The methods run on their own thread: an acquisition takes longer than a
+/// heartbeat period, and the main loop keeps heartbeating (the supervisor
+/// kills a service that goes silent) and reading the tracker meanwhile.
+fn spawn_worker(chain: MethodChain) -> anyhow::Result<(Sender<Held>, Receiver<Done>)> {
+    let (job_tx, job_rx) = channel::<Held>();
+    let (done_tx, done_rx) = channel::<Done>();
+    std::thread::Builder::new()
+        .name("acquisition".into())
+        .spawn(move || {
+            for job in job_rx {
+                let acquisition = chain.acquire(&job.points);
+                let done = Done {
+                    sequence: job.sequence,
+                    scan_end_s: job.scan_end_s,
+                    points_in: job.points.len(),
+                    acquisition,
+                };
+                if done_tx.send(done).is_err() {
+                    return;
+                }
+            }
+        })
+        .context("starting the acquisition thread")?;
+    Ok((job_tx, done_rx))
+}
+
 /// The service's moving parts.
 struct Node {
     ports: Ports,
     machine: InitStateMachine,
-    chain: MethodChain,
+    jobs: Sender<Held>,
+    done: Receiver<Done>,
+    busy: bool,
     instance: Name,
     held: Option<Held>,
     counters: Counters,
@@ -99,22 +137,29 @@ fn run(args: ServiceArgs) -> anyhow::Result<()> {
     let mut waiter = bus.waitset()?;
     waiter.attach(&ports.clouds)?;
     waiter.attach(&ports.estimates)?;
+    let (jobs, done) = spawn_worker(chain)?;
     let mut node = Node {
         ports,
         machine: InitStateMachine::new(config.state.clone())?,
-        chain,
+        jobs,
+        done,
+        busy: false,
         instance: instance_name,
         held: None,
         counters: Counters::default(),
     };
     tracing::info!(prefix = names.prefix(), instance, "init service running");
+    // While an acquisition runs, wake often enough to publish it promptly.
+    let busy_poll = Duration::from_millis(10).min(heartbeat);
     while !shutdown.load(Ordering::Relaxed) {
-        if waiter.wait(heartbeat)? == WakeReason::TerminationRequested {
+        let timeout = if node.busy { busy_poll } else { heartbeat };
+        if waiter.wait(timeout)? == WakeReason::TerminationRequested {
             break;
         }
         node.drain_estimates();
         node.drain_clouds();
-        node.acquire_if_wanted();
+        node.publish_finished()?;
+        node.start_if_wanted()?;
         health.tick(&node.counters, ServiceState::Running as u8)?;
     }
     tracing::info!(stats = ?node.machine.stats(), "init service stopping");
@@ -169,27 +214,47 @@ impl Node {
         }
     }
 
-    /// Runs the methods on the held frame when the state machine wants it,
-    /// and publishes the result.
-    fn acquire_if_wanted(&mut self) {
+    /// Hands the held frame to the worker when the state machine wants it
+    /// and no acquisition is running.
+    fn start_if_wanted(&mut self) -> anyhow::Result<()> {
+        if self.busy {
+            return Ok(());
+        }
         // The tracker may have recovered meanwhile.
         self.drain_estimates();
-        let Some(held) = self
+        if !self
             .held
             .as_ref()
-            .filter(|h| self.machine.wants(h.sequence))
-        else {
-            return;
+            .is_some_and(|h| self.machine.wants(h.sequence))
+        {
+            return Ok(());
+        }
+        if let Some(job) = self.held.take() {
+            self.jobs
+                .send(job)
+                .map_err(|_| anyhow::anyhow!("the acquisition thread ended"))?;
+            self.busy = true;
+        }
+        Ok(())
+    }
+
+    /// Publishes a finished acquisition and tells the state machine.
+    fn publish_finished(&mut self) -> anyhow::Result<()> {
+        let done = match self.done.try_recv() {
+            Ok(d) => d,
+            Err(std::sync::mpsc::TryRecvError::Empty) => return Ok(()),
+            Err(std::sync::mpsc::TryRecvError::Disconnected) => {
+                anyhow::bail!("the acquisition thread ended")
+            }
         };
-        let acquisition = self.chain.acquire(&held.points);
-        if held.points.is_empty() {
+        self.busy = false;
+        let acquisition = &done.acquisition;
+        if done.points_in == 0 {
             self.counters.rejected_empty += 1;
-        } else if acquisition.points < held.points.len() {
+        } else if acquisition.points < done.points_in {
             self.counters.rejected_non_finite += 1;
         }
-        let msg = acquisition.to_wire(held.sequence, held.scan_end_s, self.instance);
-        let sequence = held.sequence;
-        self.held = None;
+        let msg = acquisition.to_wire(done.sequence, done.scan_end_s, self.instance);
         let published_ns = match self.ports.results.send(&msg) {
             Ok(()) => {
                 self.counters.frames_out += 1;
@@ -203,7 +268,7 @@ impl Node {
         };
         let accepted = msg.success == 1 && published_ns.is_some();
         tracing::info!(
-            sequence,
+            sequence = done.sequence,
             success = msg.success,
             method = msg.method,
             f_conv_m2 = msg.f_conv_m2,
@@ -213,8 +278,9 @@ impl Node {
         );
         log_event(
             self.machine
-                .on_acquisition(sequence, accepted, published_ns),
+                .on_acquisition(done.sequence, accepted, published_ns),
         );
+        Ok(())
     }
 }
 
