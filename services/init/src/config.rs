@@ -1,5 +1,6 @@
 //! The init service's TOML configuration.
 
+use crate::cnn_method::CnnMethodConfig;
 use crate::error::InitError;
 use crate::state::InitConfig;
 use serde::{Deserialize, Serialize};
@@ -13,7 +14,7 @@ use spacepose_messages::Name;
 pub enum MethodKind {
     /// Seed 002 on-line template matching + ICP + f_CONV check.
     TemplateMatching,
-    /// Seed 004 CNN (issue 6; not available yet).
+    /// Seed 004 CNN + NDT refinement + f_CONV check (issue 6).
     Cnn,
 }
 
@@ -40,6 +41,8 @@ pub struct InitServiceConfig {
     pub state: InitConfig,
     /// Template matching, refinement and f_MAX.
     pub template_matching: TemplateMatchingConfig,
+    /// The CNN: model directory, engine, f_MAX, refinement.
+    pub cnn: CnnMethodConfig,
 }
 
 impl Default for InitServiceConfig {
@@ -53,6 +56,7 @@ impl Default for InitServiceConfig {
             min_points: 20,
             state: InitConfig::default(),
             template_matching: TemplateMatchingConfig::default(),
+            cnn: CnnMethodConfig::default(),
         }
     }
 }
@@ -80,7 +84,7 @@ impl InitServiceConfig {
             return bad("methods must list at least one method".into());
         }
         if self.methods.contains(&MethodKind::Cnn) {
-            return bad("method \"cnn\" is not available yet (issue 6)".into());
+            self.cnn.validate()?;
         }
         if self.min_points < 3 {
             return bad(format!("min_points = {} must be >= 3", self.min_points));
@@ -150,6 +154,10 @@ mod tests {
             },
             InitServiceConfig {
                 methods: vec![MethodKind::Cnn, MethodKind::TemplateMatching],
+                cnn: CnnMethodConfig {
+                    f_max_m2: f64::NAN,
+                    ..CnnMethodConfig::default()
+                },
                 ..base.clone()
             },
             InitServiceConfig {

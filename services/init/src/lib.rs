@@ -6,12 +6,13 @@
 //! - [`state::InitStateMachine`]: when to acquire (no bus, no clock).
 //! - [`chain::MethodChain`]: the configured methods tried in order on one
 //!   frame ([`method::PoseAcquirer`]); the result names the method that
-//!   succeeded. Template matching ([`template::TemplateMatching`]) is the
-//!   only method today; the CNN (issue 6) slots in first.
+//!   succeeded: the CNN ([`cnn_method::CnnMethod`], issue 6) first, with
+//!   template matching ([`template::TemplateMatching`]) as the fallback.
 //! - `src/main.rs` moves messages between the bus and these.
 #![forbid(unsafe_code)]
 
 pub mod chain;
+pub mod cnn_method;
 pub mod config;
 pub mod error;
 pub mod method;
@@ -19,6 +20,7 @@ pub mod state;
 pub mod template;
 
 pub use chain::{Acquisition, MethodChain};
+pub use cnn_method::{CnnEngine, CnnMethod, CnnMethodConfig};
 pub use config::{InitServiceConfig, MethodKind};
 pub use error::InitError;
 pub use method::{Attempt, MethodOutput, PoseAcquirer};
@@ -43,9 +45,7 @@ impl InitServiceConfig {
                     self.template_matching.clone(),
                 )?)),
                 MethodKind::Cnn => {
-                    return Err(InitError::InvalidConfig(
-                        "method \"cnn\" is not available yet (issue 6)".into(),
-                    ));
+                    methods.push(Box::new(CnnMethod::new(target.clone(), &self.cnn)?));
                 }
             }
         }
