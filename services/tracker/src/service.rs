@@ -190,7 +190,7 @@ impl TrackerNode {
         match kind {
             CommandKind::Mode => {
                 let mode = WireMode::from_u8(c.mode).map_err(|e| invalid("Command", e))?;
-                self.tracker.set_mode(mode_from_wire(mode));
+                self.tracker.set_mode(mode_from_wire(mode))?;
                 Ok(CommandOutcome::ModeSet(mode))
             }
             CommandKind::Reinit if c.has_pose() => {

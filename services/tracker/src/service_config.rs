@@ -90,7 +90,8 @@ impl TrackerServiceConfig {
     }
 
     /// Resolves the target, samples its model cloud, and builds (or loads)
-    /// the NDT map and the ICP tree (seed 000 §3.1).
+    /// the NDT map (seed 000 §3.1); the ICP model is built on first use
+    /// (`TrackingModel::icp`), at start only in `icp` mode.
     pub fn build_model(&self) -> Result<(TrackingModel, MapSource), TrackError> {
         let target = Target::resolve(&self.target, self.target_scale)
             .map_err(|e| TrackError::Model(format!("target {:?}: {e}", self.target)))?;
@@ -105,7 +106,7 @@ impl TrackerServiceConfig {
         if path.exists() {
             let map = load_map(path, &params)?;
             return Ok((
-                TrackingModel::from_map(map, &model_target)?,
+                TrackingModel::from_map(map, &model_target),
                 MapSource::Loaded(path.clone()),
             ));
         }

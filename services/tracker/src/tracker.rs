@@ -40,6 +40,10 @@ impl Tracker {
         config.validate()?;
         let filter = RelativeMotionFilter::new(config.filter.clone())?;
         let voxel = VoxelFilter::new(config.voxel_leaf_m)?;
+        if config.mode == TrackingMode::Icp {
+            // Only this mode needs it (crate::model): build it before the first frame.
+            model.icp()?;
+        }
         Ok(Self {
             config,
             model,
@@ -62,8 +66,14 @@ impl Tracker {
     }
 
     /// Changes the mode between two frames; the filter state is kept.
-    pub fn set_mode(&mut self, mode: TrackingMode) {
+    /// Switching to `icp` builds the ICP model now if it was not yet
+    /// (~1 s for deos); if that fails, the mode is left unchanged.
+    pub fn set_mode(&mut self, mode: TrackingMode) -> Result<(), TrackError> {
+        if mode == TrackingMode::Icp {
+            self.model.icp()?;
+        }
         self.config.mode = mode;
+        Ok(())
     }
 
     /// True once initialised and not lost.
@@ -201,10 +211,10 @@ impl Tracker {
     ) -> Result<Registration, TrackError> {
         let previous = last.t_sensor_target.inverse();
         let predicted = prediction.pose.inverse();
-        let (map, icp, c) = (&self.model.map, &self.model.icp, &self.config);
+        let (map, c) = (&self.model.map, &self.config);
         Ok(match c.mode {
             TrackingMode::Ndt => register_ndt(map, cloud, &previous, &c.ndt)?,
-            TrackingMode::Icp => register_icp(icp, cloud, &previous, &c.icp)?,
+            TrackingMode::Icp => register_icp(self.model.icp()?, cloud, &previous, &c.icp)?,
             TrackingMode::Deblur => register_ndt(map, cloud, &predicted, &c.ndt)?,
             TrackingMode::CtNdt => {
                 // T^s is the previous result (seed 000 §3.3) carried to the
