@@ -111,6 +111,28 @@ pub struct BridgeStats {
     pub errors: u64,
 }
 
+/// Transit time of the samples a bridge took from zenoh on one topic: from
+/// the sender's `published_ns` (stamped when it was published on the other
+/// host's iceoryx2) to their re-publication here. Wall clock: meaningful
+/// when the hosts' clocks are synchronised (one machine, or PTP/NTP);
+/// samples that seem to arrive before they were sent are not counted.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LinkLatency {
+    /// Samples measured.
+    pub samples: u64,
+    /// Mean transit time (ms).
+    pub mean_ms: f64,
+    /// Largest transit time (ms).
+    pub max_ms: f64,
+}
+
+#[derive(Debug, Default)]
+pub(crate) struct LatencySum {
+    sum_us: AtomicU64,
+    max_us: AtomicU64,
+    samples: AtomicU64,
+}
+
 #[derive(Debug, Default)]
 pub(crate) struct Counters {
     pub(crate) forwarded_to_zenoh: AtomicU64,
@@ -118,11 +140,45 @@ pub(crate) struct Counters {
     pub(crate) rejected_wire: AtomicU64,
     pub(crate) rate_limited: AtomicU64,
     pub(crate) errors: AtomicU64,
+    /// Per topic, in the order of `Topic::ALL`.
+    latency: [LatencySum; Topic::ALL.len()],
+}
+
+fn topic_index(topic: Topic) -> usize {
+    Topic::ALL.iter().position(|t| *t == topic).unwrap_or(0)
 }
 
 impl Counters {
     pub(crate) fn bump(counter: &AtomicU64) {
         counter.fetch_add(1, Ordering::Relaxed);
+    }
+
+    /// Records the transit of a sample of `topic` sent at `sent_ns`
+    /// (CLOCK_REALTIME) and re-published at `now_ns`.
+    pub(crate) fn transit(&self, topic: Topic, sent_ns: i64, now_ns: i64) {
+        if sent_ns <= 0 || now_ns < sent_ns {
+            return;
+        }
+        let us = ((now_ns - sent_ns) / 1000) as u64;
+        let l = &self.latency[topic_index(topic)];
+        l.sum_us.fetch_add(us, Ordering::Relaxed);
+        l.max_us.fetch_max(us, Ordering::Relaxed);
+        l.samples.fetch_add(1, Ordering::Relaxed);
+    }
+
+    fn latency(&self, topic: Topic) -> LinkLatency {
+        let l = &self.latency[topic_index(topic)];
+        let samples = l.samples.load(Ordering::Relaxed);
+        let sum_us = l.sum_us.load(Ordering::Relaxed);
+        LinkLatency {
+            samples,
+            mean_ms: if samples == 0 {
+                0.0
+            } else {
+                sum_us as f64 / samples as f64 / 1000.0
+            },
+            max_ms: l.max_us.load(Ordering::Relaxed) as f64 / 1000.0,
+        }
     }
 
     fn snapshot(&self) -> BridgeStats {
@@ -230,6 +286,11 @@ impl Bridge {
         self.counters.snapshot()
     }
 
+    /// Transit time of the samples of `topic` taken from zenoh so far.
+    pub fn link_latency(&self, topic: Topic) -> LinkLatency {
+        self.counters.latency(topic)
+    }
+
     /// True while every worker thread is running.
     pub fn is_running(&self) -> bool {
         self.workers.iter().all(|w| !w.is_finished())
@@ -314,6 +375,14 @@ mod tests {
             Some(DEFAULT_CLOUD_RATE_HZ)
         );
         assert_eq!(Route::to_zenoh(Topic::Pose).max_rate_hz, None);
+        let c = Counters::default();
+        c.transit(Topic::Pose, 1_000_000, 3_000_000);
+        c.transit(Topic::Pose, 1_000_000, 5_000_000);
+        c.transit(Topic::Pose, 5_000_000, 1_000_000); // clock skew: ignored
+        c.transit(Topic::Cloud, 0, 1_000_000); // not stamped: ignored
+        let l = c.latency(Topic::Pose);
+        assert_eq!((l.samples, l.mean_ms, l.max_ms), (2, 3.0, 4.0));
+        assert_eq!(c.latency(Topic::Cloud).samples, 0);
         assert_eq!(
             Route::to_zenoh(Topic::Pose)
                 .with_rate(Some(4.0))

@@ -26,7 +26,7 @@ pub mod waiter;
 pub mod zenoh_access;
 pub mod zenoh_session;
 
-pub use bridge::{Bridge, BridgeStats, Direction, Route};
+pub use bridge::{Bridge, BridgeStats, Direction, LinkLatency, Route};
 pub use cloud::{CloudPublisher, CloudSample, CloudSubscriber};
 pub use error::BusError;
 pub use node::{Bus, cleanup_dead_nodes, iceoryx2_config};

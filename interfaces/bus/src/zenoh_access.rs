@@ -41,6 +41,19 @@ use serde_json::{Value, json};
 use spacepose_messages::{Names, Topic};
 use std::path::{Path, PathBuf};
 
+/// Every message kind zenoh's ACL knows (the `peers` role gets them all).
+const ALL_MESSAGES: [&str; 9] = [
+    "put",
+    "delete",
+    "declare_subscriber",
+    "query",
+    "declare_queryable",
+    "reply",
+    "liveliness_token",
+    "declare_liveliness_subscriber",
+    "liveliness_query",
+];
+
 /// Who may do what on the ground link of a suite peer that accepts
 /// connections (the telemetry service, which hosts the command bridge).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -137,10 +150,27 @@ impl AccessControl {
     /// Checks the accounts: at least one operator, valid user names, no
     /// account in two roles, and every account present in the dictionary.
     pub fn validate(&self) -> Result<(), BusError> {
-        let bad = |m: String| Err(BusError::Zenoh(format!("access control: {m}")));
         if self.operators.is_empty() {
-            return bad("no operator account: nobody could send commands".into());
+            return Err(BusError::Zenoh(
+                "access control: no operator account: nobody could send commands".into(),
+            ));
         }
+        self.check_accounts()
+    }
+
+    /// Checks the accounts of a suite link ([`Self::apply_link`]): at least
+    /// one peer, valid user names, every account in the dictionary.
+    pub fn validate_link(&self) -> Result<(), BusError> {
+        if self.peers.is_empty() {
+            return Err(BusError::Zenoh(
+                "link access control: no peer account: no host could connect".into(),
+            ));
+        }
+        self.check_accounts()
+    }
+
+    fn check_accounts(&self) -> Result<(), BusError> {
+        let bad = |m: String| Err(BusError::Zenoh(format!("access control: {m}")));
         let all: Vec<&String> = self
             .operators
             .iter()
@@ -208,17 +238,6 @@ impl AccessControl {
             policies.push(json!({ "id": "suite-peers", "subjects": ["peers"],
                                   "rules": ["peer-in", "peer-out"] }));
         }
-        const ALL: [&str; 9] = [
-            "put",
-            "delete",
-            "declare_subscriber",
-            "query",
-            "declare_queryable",
-            "reply",
-            "liveliness_token",
-            "declare_liveliness_subscriber",
-            "liveliness_query",
-        ];
         json!({
             "enabled": true,
             "default_permission": "deny",
@@ -228,18 +247,53 @@ impl AccessControl {
                      &["put", "delete", "reply", "declare_queryable"], &telemetry),
                 rule("command-in", "ingress", &["put"], &command),
                 rule("command-out", "egress", &["declare_subscriber"], &command),
-                rule("peer-in", "ingress", &ALL, &everything),
-                rule("peer-out", "egress", &ALL, &everything),
+                rule("peer-in", "ingress", &ALL_MESSAGES, &everything),
+                rule("peer-out", "egress", &ALL_MESSAGES, &everything),
             ],
             "subjects": subjects,
             "policies": policies,
         })
     }
 
-    /// Makes `config` require an account of the dictionary from every
-    /// connecting peer and enforce the policy of deployment `names`.
-    pub fn apply(&self, names: &Names, config: &mut zenoh::Config) -> Result<(), BusError> {
-        self.validate()?;
+    /// The `access_control` block of a suite link (the zenoh session of a
+    /// host's bridge in a partitioned deployment whose keys are below
+    /// `names`): only the `peers` accounts, everything below
+    /// `spacepose/{p}/**`, default deny. Operators and readers talk to the
+    /// telemetry service, not to the link.
+    pub fn link_acl_json(&self, names: &Names) -> Value {
+        let everything = names.zenoh_key("**");
+        json!({
+            "enabled": true,
+            "default_permission": "deny",
+            "rules": [
+                { "id": "peer-in", "permission": "allow", "flows": ["ingress"],
+                  "messages": ALL_MESSAGES, "key_exprs": [everything] },
+                { "id": "peer-out", "permission": "allow", "flows": ["egress"],
+                  "messages": ALL_MESSAGES, "key_exprs": [everything] },
+            ],
+            "subjects": [{ "id": "peers", "usernames": self.peers }],
+            "policies": [{ "id": "suite-peers", "subjects": ["peers"],
+                           "rules": ["peer-in", "peer-out"] }],
+        })
+    }
+
+    /// Makes `config` (a host's link session) require a `peers` account of
+    /// the dictionary from every connecting host and enforce
+    /// [`Self::link_acl_json`].
+    ///
+    /// zenoh's usrpwd authenticates the side that connects to the side that
+    /// accepts, not the other way round: the accepting session knows the
+    /// connecting host's user name, the connecting one does not know the
+    /// acceptor's. So only sessions that listen get this ACL (a connecting
+    /// session with it would deny its own links); hosts that only connect
+    /// listen nowhere and trust the endpoint they were told to connect to.
+    pub fn apply_link(&self, names: &Names, config: &mut zenoh::Config) -> Result<(), BusError> {
+        self.validate_link()?;
+        self.set_dictionary(config)?;
+        set(config, "access_control", &self.link_acl_json(names))
+    }
+
+    fn set_dictionary(&self, config: &mut zenoh::Config) -> Result<(), BusError> {
         let dictionary = self.dictionary_file.to_str().ok_or_else(|| {
             BusError::Zenoh(format!(
                 "access control: dictionary path {} is not UTF-8",
@@ -250,7 +304,14 @@ impl AccessControl {
             config,
             "transport/auth/usrpwd/dictionary_file",
             &json!(dictionary),
-        )?;
+        )
+    }
+
+    /// Makes `config` require an account of the dictionary from every
+    /// connecting peer and enforce the policy of deployment `names`.
+    pub fn apply(&self, names: &Names, config: &mut zenoh::Config) -> Result<(), BusError> {
+        self.validate()?;
+        self.set_dictionary(config)?;
         set(config, "access_control", &self.acl_json(names))
     }
 }
@@ -316,6 +377,42 @@ mod tests {
         a.readers.clear();
         assert!(a.validate().is_err());
         assert!(toml_like_parse(r#"{"dictionary_file":"x","operators":[],"writers":[]}"#).is_err());
+    }
+
+    #[test]
+    fn a_suite_link_admits_only_peers_and_needs_no_operator() {
+        let d = dictionary("host-a:pa\nhost-b:pb\n");
+        let names = Names::new("orbit").unwrap();
+        let link = AccessControl {
+            dictionary_file: d.path().to_path_buf(),
+            operators: Vec::new(),
+            readers: Vec::new(),
+            peers: vec!["host-a".into(), "host-b".into()],
+        };
+        let mut c = ZenohConfigForTest::config();
+        link.apply_link(&names, &mut c).unwrap();
+        let acl = link.link_acl_json(&names);
+        assert_eq!(acl["default_permission"], "deny");
+        assert_eq!(acl["rules"][0]["key_exprs"][0], "spacepose/orbit/**");
+        assert_eq!(acl["subjects"][0]["usernames"], json!(["host-a", "host-b"]));
+        assert_eq!(
+            c.get_json("access_control/default_permission").unwrap(),
+            "\"deny\""
+        );
+        // The ground-link policy still insists on an operator.
+        assert!(link.validate().is_err());
+        let mut none = link.clone();
+        none.peers.clear();
+        assert!(none.apply_link(&names, &mut c).is_err());
+        let mut unknown = link;
+        unknown.peers.push("host-x".into());
+        assert!(
+            unknown
+                .validate_link()
+                .unwrap_err()
+                .to_string()
+                .contains("host-x")
+        );
     }
 
     #[test]

@@ -12,7 +12,9 @@ pub const DEFAULT_ZENOH_PORT: u16 = 7447;
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ZenohConfig {
-    /// `"peer"` (default) or `"client"` (e.g. a ground tool connecting to a peer).
+    /// `"peer"` (default), `"client"` (e.g. a ground tool connecting to a
+    /// peer) or `"router"` (the hub of a partitioned suite: it routes
+    /// between the hosts connected to it, which peers do not since zenoh 1.9).
     pub mode: String,
     /// Endpoints to listen on, e.g. `"tcp/127.0.0.1:7447"` (loopback by default).
     pub listen: Vec<String>,
@@ -57,9 +59,9 @@ impl ZenohConfig {
 
     /// The zenoh configuration.
     pub fn to_zenoh(&self) -> Result<zenoh::Config, BusError> {
-        if self.mode != "peer" && self.mode != "client" {
+        if !["peer", "client", "router"].contains(&self.mode.as_str()) {
             return Err(BusError::Zenoh(format!(
-                "mode {:?} (expected \"peer\" or \"client\")",
+                "mode {:?} (expected \"peer\", \"client\" or \"router\")",
                 self.mode
             )));
         }
@@ -172,5 +174,15 @@ mod tests {
                 .contains("127.0.0.1:7447")
         );
         assert_eq!(z.get_json("scouting/multicast/enabled").unwrap(), "false");
+        let mut router = ZenohConfig {
+            mode: "router".into(),
+            ..ZenohConfig::default()
+        };
+        assert_eq!(
+            router.to_zenoh().unwrap().get_json("mode").unwrap(),
+            "\"router\""
+        );
+        router.mode = "broker".into();
+        assert!(router.to_zenoh().is_err());
     }
 }

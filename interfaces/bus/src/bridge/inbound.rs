@@ -8,7 +8,7 @@ use crate::node::Bus;
 use crate::pubsub::{Msg, Publisher};
 use spacepose_messages::{
     AcquisitionResult, CloudMsg, CodecError, Command, FilterState, Health, MAX_POINTS, Names,
-    PoseEstimate, Topic, TruthMsg, decode,
+    PoseEstimate, Topic, TruthMsg, decode, realtime_ns,
 };
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -26,17 +26,21 @@ enum InjectError {
 
 /// One topic injected into iceoryx2.
 trait Inject {
-    fn inject(&mut self, bytes: &[u8]) -> Result<(), InjectError>;
+    /// Decodes and re-publishes; returns the sender's `published_ns` (0
+    /// when the message carries none).
+    fn inject(&mut self, bytes: &[u8]) -> Result<i64, InjectError>;
 }
 
 struct FixedIn<T: Msg> {
     publisher: Publisher<T>,
+    sent_ns: fn(&T) -> i64,
 }
 
 impl<T: Msg> Inject for FixedIn<T> {
-    fn inject(&mut self, bytes: &[u8]) -> Result<(), InjectError> {
+    fn inject(&mut self, bytes: &[u8]) -> Result<i64, InjectError> {
         let msg = decode::<T>(bytes).map_err(InjectError::Codec)?;
-        self.publisher.send(&msg).map_err(InjectError::Bus)
+        self.publisher.send(&msg).map_err(InjectError::Bus)?;
+        Ok((self.sent_ns)(&msg))
     }
 }
 
@@ -45,31 +49,37 @@ struct CloudIn {
 }
 
 impl Inject for CloudIn {
-    fn inject(&mut self, bytes: &[u8]) -> Result<(), InjectError> {
+    fn inject(&mut self, bytes: &[u8]) -> Result<i64, InjectError> {
         let msg = decode::<CloudMsg>(bytes).map_err(InjectError::Codec)?;
         self.publisher
             .send(msg.header, &msg.points)
-            .map_err(InjectError::Bus)
+            .map_err(InjectError::Bus)?;
+        Ok(msg.header.published_ns)
     }
 }
 
 fn injector(bus: &Bus, topic: Topic) -> Result<Box<dyn Inject>, BusError> {
     let service = bus.names().service(topic);
-    fn fixed<T: Msg>(bus: &Bus, service: &str) -> Result<Box<dyn Inject>, BusError> {
+    fn fixed<T: Msg>(
+        bus: &Bus,
+        service: &str,
+        sent_ns: fn(&T) -> i64,
+    ) -> Result<Box<dyn Inject>, BusError> {
         Ok(Box::new(FixedIn::<T> {
             publisher: bus.publisher::<T>(service)?,
+            sent_ns,
         }))
     }
     match topic {
         Topic::RawCloud | Topic::Cloud => Ok(Box::new(CloudIn {
             publisher: bus.cloud_publisher(&service, MAX_POINTS)?,
         })),
-        Topic::Pose => fixed::<PoseEstimate>(bus, &service),
-        Topic::FilterState => fixed::<FilterState>(bus, &service),
-        Topic::Acquisition => fixed::<AcquisitionResult>(bus, &service),
-        Topic::Truth => fixed::<TruthMsg>(bus, &service),
-        Topic::Health => fixed::<Health>(bus, &service),
-        Topic::Command => fixed::<Command>(bus, &service),
+        Topic::Pose => fixed::<PoseEstimate>(bus, &service, |m| m.published_ns),
+        Topic::FilterState => fixed::<FilterState>(bus, &service, |m| m.published_ns),
+        Topic::Acquisition => fixed::<AcquisitionResult>(bus, &service, |_| 0),
+        Topic::Truth => fixed::<TruthMsg>(bus, &service, |_| 0),
+        Topic::Health => fixed::<Health>(bus, &service, |m| m.published_ns),
+        Topic::Command => fixed::<Command>(bus, &service, |_| 0),
     }
 }
 
@@ -146,7 +156,11 @@ impl Worker {
         }
         let topic = self.routes[i].topic.as_str();
         match injector.inject(&bytes) {
-            Ok(()) => Counters::bump(&self.counters.forwarded_from_zenoh),
+            Ok(sent_ns) => {
+                Counters::bump(&self.counters.forwarded_from_zenoh);
+                self.counters
+                    .transit(self.routes[i].topic, sent_ns, realtime_ns());
+            }
             Err(InjectError::Codec(e)) => {
                 Counters::bump(&self.counters.rejected_wire);
                 // Every rejection is counted; the log is throttled (the first
