@@ -43,21 +43,35 @@ impl Centering {
 
 /// The sensor side of Eq. (1), prepared once per acquisition: the sensor
 /// points relative to their centre (optionally a subsample).
-#[derive(Debug, Clone)]
 pub struct Correlator {
     centred: Vec<[f64; 3]>,
     centering: Centering,
+    /// kd-tree over `centred` for the symmetric variant.
+    sensor_tree: Option<ImmutableKdTree<f64, 3>>,
+}
+
+impl std::fmt::Debug for Correlator {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Correlator")
+            .field("points", &self.centred.len())
+            .field("centering", &self.centering)
+            .field("symmetric", &self.sensor_tree.is_some())
+            .finish()
+    }
 }
 
 impl Correlator {
     /// `sensor` (finite points, sensor frame) centred on `sensor_centre`.
     /// With `max_points > 0` and more points than that, an evenly strided
-    /// subsample of about `max_points` is used (a cheaper C).
+    /// subsample of about `max_points` is used (a cheaper C). With
+    /// `symmetric`, C also averages the template-to-sensor distances (see
+    /// [`Correlator::correlation`]).
     pub fn new(
         sensor: &[Vector3<f64>],
         sensor_centre: &Vector3<f64>,
         centering: Centering,
         max_points: usize,
+        symmetric: bool,
     ) -> Self {
         let stride = if max_points > 0 && sensor.len() > max_points {
             sensor.len().div_ceil(max_points)
@@ -71,8 +85,22 @@ impl Correlator {
                 let c = p - sensor_centre;
                 [c.x, c.y, c.z]
             })
-            .collect();
-        Self { centred, centering }
+            .collect::<Vec<_>>();
+        let sensor_tree = if symmetric && !centred.is_empty() {
+            ImmutableKdTree::new_from_slice(&centred).ok()
+        } else {
+            None
+        };
+        Self {
+            centred,
+            centering,
+            sensor_tree,
+        }
+    }
+
+    /// How clouds are centred.
+    pub fn centering(&self) -> Centering {
+        self.centering
     }
 
     /// Points used in Eq. (1).
@@ -90,6 +118,10 @@ impl Correlator {
     /// template so that the centres coincide. Also returns the template's
     /// centre (sensor frame, before translation). `None` for a template with
     /// fewer than 3 points.
+    ///
+    /// Symmetric variant (not in seed 002): the mean of Eq. (1) and of the
+    /// same mean taken from the template points to the sensor cloud, so a
+    /// template showing parts the sensor does not see is penalised too.
     pub fn correlation(
         &self,
         template: &[Vector3<f64>],
@@ -117,7 +149,21 @@ impl Correlator {
                     .distance
             })
             .sum();
-        Some((sum / self.centred.len() as f64, centre))
+        let mut c = sum / self.centred.len() as f64;
+        if let Some(sensor_tree) = &self.sensor_tree {
+            let back: f64 = entries
+                .iter()
+                .map(|q| {
+                    sensor_tree
+                        .query(q)
+                        .nearest_one::<SquaredEuclidean<f64>>()
+                        .execute()
+                        .distance
+                })
+                .sum();
+            c = 0.5 * (c + back / entries.len() as f64);
+        }
+        Some((c, centre))
     }
 }
 
@@ -146,7 +192,7 @@ mod tests {
         let mut s = Vec::new();
         for centering in [Centering::Mean, Centering::Trimmed(0.25)] {
             let c0 = centering.centre(&cloud, &mut s).unwrap();
-            let corr = Correlator::new(&cloud, &c0, centering, 0);
+            let corr = Correlator::new(&cloud, &c0, centering, 0, false);
             let (c, centre) = corr.correlation(&cloud, &mut s).unwrap();
             assert!(c < 1e-20, "{c}");
             assert!((centre - c0).norm() < 1e-12);
@@ -177,10 +223,10 @@ mod tests {
     #[test]
     fn tiny_template_gives_none() {
         let cloud = cube_cloud();
-        let corr = Correlator::new(&cloud, &Vector3::zeros(), Centering::Mean, 0);
+        let corr = Correlator::new(&cloud, &Vector3::zeros(), Centering::Mean, 0, false);
         assert!(corr.correlation(&cloud[..2], &mut Vec::new()).is_none());
         assert_eq!(
-            Correlator::new(&cloud, &Vector3::zeros(), Centering::Mean, 10).len(),
+            Correlator::new(&cloud, &Vector3::zeros(), Centering::Mean, 10, false).len(),
             10
         );
     }

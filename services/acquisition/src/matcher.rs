@@ -10,7 +10,7 @@ use crate::refine::{Refined, refine};
 use crate::template::TemplateRenderer;
 use nalgebra::{Rotation3, Vector3};
 use rayon::prelude::*;
-use spacepose_geometry::{Euler321, Point, Pose};
+use spacepose_geometry::{Euler321, Point, Pose, so3};
 use spacepose_lidar_sim::{LidarSimulator, SensorConfig};
 use spacepose_registration::IcpModel;
 use spacepose_target::Target;
@@ -27,9 +27,13 @@ enum Score {
     Empty,
     /// Rejected by Eq. (3).
     Rejected,
-    /// C of Eq. (1) and the template's centre (sensor frame).
+    /// C of Eq. (1) and the target origin it implies (sensor frame): the
+    /// render position moved by the centroid alignment.
     Scored(f64, Vector3<f64>),
 }
+
+/// A scored template: grid index, C, implied target origin.
+type Ranked = (usize, f64, Vector3<f64>);
 
 /// Per-acquisition inputs shared by every template evaluation.
 struct Sensed<'a> {
@@ -99,6 +103,16 @@ impl TemplateMatcher {
         &self.target
     }
 
+    /// The ICP model (target surface sample with its lookup structures).
+    pub fn icp_model(&self) -> &IcpModel {
+        &self.icp_model
+    }
+
+    /// The grid attitudes `(Euler angles, rotation)`.
+    pub fn grid(&self) -> &[(Euler321, Rotation3<f64>)] {
+        &self.grid
+    }
+
     /// Number of grid attitudes (templates per full pass).
     pub fn grid_len(&self) -> usize {
         self.grid.len()
@@ -159,6 +173,7 @@ impl TemplateMatcher {
             &centre,
             centering,
             self.config.max_correlation_points,
+            self.config.symmetric_correlation,
         );
         let sensed = Sensed {
             correlator: &correlator,
@@ -176,13 +191,10 @@ impl TemplateMatcher {
         let matching_ms = ms_since(start);
 
         // Template solution(s): grid attitude, origin from the centroid alignment.
-        let candidates: Vec<(usize, Pose)> = ranked
-            .iter()
-            .take(self.config.icp_candidates)
-            .map(|&(k, _, template_centre)| {
-                let t = centre + (centre - template_centre);
-                (k, Pose::new(self.grid[k].1, t))
-            })
+        let candidates: Vec<(usize, Pose)> = self
+            .distinct_candidates(&ranked)
+            .into_iter()
+            .map(|(k, origin)| (k, Pose::new(self.grid[k].1, origin)))
             .collect();
         let refine_start = Instant::now();
         let refined: Vec<Result<Refined, String>> = candidates
@@ -198,6 +210,10 @@ impl TemplateMatcher {
             .filter_map(|(i, r)| r.as_ref().ok().map(|r| (i, r)))
             .min_by(|a, b| a.1.f_conv_m2.total_cmp(&b.1.f_conv_m2));
         let coarse_of = |rank: usize| candidates[rank].1;
+        let c_of = |rank: usize| {
+            let k = candidates[rank].0;
+            ranked.iter().find(|r| r.0 == k).map_or(best_c, |r| r.1)
+        };
         let (chosen_rank, pose, f_conv, iterations, converged, inliers, refinement_error) =
             match best {
                 Some((i, r)) => (
@@ -226,11 +242,7 @@ impl TemplateMatcher {
             t_sensor_target_coarse: coarse_of(chosen_rank),
             euler_coarse: self.grid[chosen_k].0,
             centroid_m: [centre.x, centre.y, centre.z],
-            correlation_m2: if chosen_rank == 0 {
-                best_c
-            } else {
-                ranked[chosen_rank].1
-            },
+            correlation_m2: c_of(chosen_rank),
             f_conv_m2: f_conv,
             accepted: f_conv_ok,
             templates_generated: generated,
@@ -249,10 +261,34 @@ impl TemplateMatcher {
         })
     }
 
-    /// Renders and scores the templates: `(grid index, C, template centre)`
+    /// The `icp_candidates` best templates, skipping any closer than
+    /// `candidate_separation_deg` to a better one: `(grid index, origin)`.
+    fn distinct_candidates(
+        &self,
+        ranked: &[(usize, f64, Vector3<f64>)],
+    ) -> Vec<(usize, Vector3<f64>)> {
+        let min_sep = self.config.candidate_separation_deg.to_radians();
+        let mut chosen: Vec<(usize, Vector3<f64>)> = Vec::new();
+        for &(k, _, centre) in ranked {
+            if chosen.len() == self.config.icp_candidates {
+                break;
+            }
+            let r = &self.grid[k].1;
+            if chosen
+                .iter()
+                .all(|(j, _)| so3::distance(&self.grid[*j].1, r) >= min_sep)
+            {
+                chosen.push((k, centre));
+            }
+        }
+        chosen
+    }
+
+    /// Renders and scores the templates: `(grid index, C, implied origin)`
     /// sorted by C, templates generated, templates rejected by Eq. (3).
-    fn match_templates(&self, sensed: &Sensed) -> (Vec<(usize, f64, Vector3<f64>)>, usize, usize) {
-        let all: Vec<usize> = (0..self.grid.len()).collect();
+    fn match_templates(&self, sensed: &Sensed) -> (Vec<Ranked>, usize, usize) {
+        let all: Vec<(usize, Vector3<f64>)> =
+            (0..self.grid.len()).map(|k| (k, sensed.centre)).collect();
         let (first, fine) = match (&self.coarse_renderer, self.config.coarse_to_fine) {
             (Some(coarse), Some(c)) => (coarse, Some(c.keep)),
             _ => (&self.renderer, None),
@@ -262,8 +298,14 @@ impl TemplateMatcher {
         let rejected = scores.iter().filter(|s| s.1 == Score::Rejected).count();
         let mut ranked = rank(&scores);
         if let Some(keep) = fine {
-            let kept: Vec<usize> = ranked.iter().take(keep).map(|r| r.0).collect();
-            // Eq. (3) was applied on the coarse pass.
+            // Rendered at the sensor centroid as in the coarse pass (rendering
+            // where the alignment put the origin measured worse); Eq. (3) was
+            // applied on the coarse pass.
+            let kept: Vec<(usize, Vector3<f64>)> = ranked
+                .iter()
+                .take(keep)
+                .map(|r| (r.0, sensed.centre))
+                .collect();
             let scores = self.score(&kept, &self.renderer, sensed, false);
             generated += scores.len();
             ranked = rank(&scores);
@@ -271,16 +313,19 @@ impl TemplateMatcher {
         (ranked, generated, rejected)
     }
 
-    /// Scores the grid attitudes `indices` with `renderer`.
+    /// Scores the grid attitudes `jobs` (grid index, render position) with
+    /// `renderer`.
     fn score(
         &self,
-        indices: &[usize],
+        jobs: &[(usize, Vector3<f64>)],
         renderer: &TemplateRenderer,
         sensed: &Sensed,
         fast: bool,
     ) -> Vec<(usize, Score)> {
-        let one = |k: usize, template: &mut Vec<Vector3<f64>>, scratch: &mut Vec<f64>| {
-            renderer.render_into(&self.grid[k].1, &sensed.centre, template);
+        let one = |&(k, at): &(usize, Vector3<f64>),
+                   template: &mut Vec<Vector3<f64>>,
+                   scratch: &mut Vec<f64>| {
+            renderer.render_into(&self.grid[k].1, &at, template);
             if template.len() < 3 {
                 return (k, Score::Empty);
             }
@@ -288,23 +333,26 @@ impl TemplateMatcher {
                 return (k, Score::Rejected);
             }
             match sensed.correlator.correlation(template, scratch) {
-                Some((c, centre)) => (k, Score::Scored(c, centre)),
+                // Centroid alignment moves the template, hence the target
+                // origin, by (sensor centre - template centre).
+                Some((c, template_centre)) => {
+                    (k, Score::Scored(c, at + sensed.centre - template_centre))
+                }
                 None => (k, Score::Empty),
             }
         };
         match self.config.threads {
             Threads::Single => {
                 let (mut template, mut scratch) = (Vec::new(), Vec::new());
-                indices
-                    .iter()
-                    .map(|&k| one(k, &mut template, &mut scratch))
+                jobs.iter()
+                    .map(|job| one(job, &mut template, &mut scratch))
                     .collect()
             }
-            Threads::All => indices
+            Threads::All => jobs
                 .par_iter()
                 .map_init(
                     || (Vec::new(), Vec::new()),
-                    |(template, scratch), &k| one(k, template, scratch),
+                    |(template, scratch), job| one(job, template, scratch),
                 )
                 .collect(),
         }
@@ -312,11 +360,11 @@ impl TemplateMatcher {
 }
 
 /// The scored templates sorted by C (ties by grid index).
-fn rank(scores: &[(usize, Score)]) -> Vec<(usize, f64, Vector3<f64>)> {
-    let mut ranked: Vec<(usize, f64, Vector3<f64>)> = scores
+fn rank(scores: &[(usize, Score)]) -> Vec<Ranked> {
+    let mut ranked: Vec<Ranked> = scores
         .iter()
         .filter_map(|&(k, s)| match s {
-            Score::Scored(c, centre) => Some((k, c, centre)),
+            Score::Scored(c, origin) => Some((k, c, origin)),
             _ => None,
         })
         .collect();

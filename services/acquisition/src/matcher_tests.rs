@@ -53,8 +53,9 @@ fn noise_free_envisat_at_20_m_is_recovered_after_icp() {
         "{err_deg} deg {err_m} m {out:?}"
     );
     assert!(out.accepted && out.f_conv_m2 < 1e-3, "{}", out.f_conv_m2);
-    assert_eq!(out.templates_generated, 605);
-    assert_eq!(out.templates_evaluated + out.templates_rejected, 605);
+    // Coarse-to-fine (default): 605 thinned templates, then the best 30.
+    assert_eq!(out.templates_generated, 605 + 30);
+    assert_eq!(out.templates_evaluated, 30);
     let coarse_deg = so3::distance(&out.t_sensor_target_coarse.rotation, &r).to_degrees();
     assert!(coarse_deg < 45.0, "{coarse_deg}");
 }
@@ -149,7 +150,11 @@ fn single_thread_and_parallel_agree() {
     let corr = {
         let p: Vec<Vector3<f64>> = cloud.iter().map(Point::position).collect();
         let c = spacepose_geometry::centroid(&p).unwrap();
-        (Correlator::new(&p, &c, Centering::Mean, 0), c, d_bor(&p))
+        (
+            Correlator::new(&p, &c, Centering::Mean, 0, false),
+            c,
+            d_bor(&p),
+        )
     };
     let sensed = Sensed {
         correlator: &corr.0,

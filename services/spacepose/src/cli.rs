@@ -44,6 +44,9 @@ pub enum Command {
     Demo(DemoArgs),
     /// Ground tool: telemetry over zenoh as a live table, optionally recorded.
     Ground(GroundArgs),
+    /// Derive thresholds from simulated runs.
+    #[command(subcommand)]
+    Calibrate(crate::calibrate::CalibrateCommand),
 }
 
 /// zenoh endpoint overrides of a descriptor.
@@ -158,6 +161,8 @@ pub struct GroundArgs {
 pub enum EvalCommand {
     /// Tracking accuracy and speed per mode, as seed 000 Tables 2-3.
     Tracking(EvalTrackingArgs),
+    /// Template-matching acquisition (seed 002 §4): success rate, time, f_CONV.
+    Tm(crate::eval::tm::EvalTmArgs),
 }
 
 /// Scenario names accepted on the command line.

@@ -2,6 +2,7 @@
 //! with a `run` function, so tests can call it without spawning a process.
 #![forbid(unsafe_code)]
 
+pub mod calibrate;
 pub mod cli;
 pub mod common;
 pub mod dataset_cmd;

@@ -5,4 +5,5 @@
 pub mod plot;
 pub mod stats;
 pub mod table;
+pub mod tm;
 pub mod tracking;
