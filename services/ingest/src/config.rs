@@ -67,6 +67,13 @@ pub struct IngestConfig {
     pub leaf_size_m: f64,
     /// Largest accepted frame (points); larger frames are rejected.
     pub max_points: usize,
+    /// A forwarded frame with fewer points than this after the crop and the
+    /// voxel filter is counted (and logged) as "target not seen"
+    /// (`IngestStats::frames_without_target`). Counting only: the frame is
+    /// forwarded either way, and the tracker decides with its own
+    /// `loss.min_points` whether it can register it. >= 1. Default 20, the
+    /// init service's `min_points` and the tracker's `loss.min_points`.
+    pub min_target_points: usize,
     /// Optional region of interest used before acquisition (no prediction),
     /// sensor frame.
     pub static_box: Option<AxisBox>,
@@ -80,7 +87,8 @@ pub struct IngestConfig {
 
 impl Default for IngestConfig {
     /// 0.5-60 m range gate, `deos` bounding radius and body box, 0.25 m
-    /// margin, 10 s prediction age, 2 cm voxels, 200,000 points, no static box.
+    /// margin, 10 s prediction age, 2 cm voxels, 200,000 points, target not
+    /// seen below 20 points, no static box.
     fn default() -> Self {
         IngestConfig {
             min_range_m: 0.5,
@@ -90,6 +98,7 @@ impl Default for IngestConfig {
             max_prediction_age_s: 10.0,
             leaf_size_m: 0.02,
             max_points: DEFAULT_MAX_POINTS,
+            min_target_points: 20,
             static_box: None,
             body_box: Some(AxisBox::deos()),
         }
@@ -114,6 +123,9 @@ impl IngestConfig {
         non_negative("leaf_size_m", self.leaf_size_m)?;
         if self.max_points == 0 {
             return Err(invalid("max_points", 0.0, "must be >= 1"));
+        }
+        if self.min_target_points == 0 {
+            return Err(invalid("min_target_points", 0.0, "must be >= 1"));
         }
         if let Some(b) = &self.static_box {
             check_box("static_box.min_m", "static_box.max_m", b)?;
@@ -217,6 +229,10 @@ mod tests {
             },
             IngestConfig {
                 max_points: 0,
+                ..Default::default()
+            },
+            IngestConfig {
+                min_target_points: 0,
                 ..Default::default()
             },
             IngestConfig {

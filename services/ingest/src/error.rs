@@ -4,6 +4,11 @@ use spacepose_geometry::GeometryError;
 
 /// Everything that can go wrong while ingesting a frame or building the
 /// ingest stage. A rejected frame is one of these values, never a panic.
+///
+/// A frame with no point is *not* an error (there is no `EmptyFrame`): a
+/// sensor that delivered a well-formed frame (finite, ordered scan interval)
+/// with nothing in it saw nothing, which is a valid observation "target not
+/// seen" and is forwarded downstream (see the crate docs).
 #[derive(Debug, thiserror::Error)]
 pub enum IngestError {
     /// A configuration value is NaN, infinite or out of its range.
@@ -16,10 +21,6 @@ pub enum IngestError {
         /// Why it is rejected.
         reason: &'static str,
     },
-
-    /// The frame holds no point at all.
-    #[error("empty frame")]
-    EmptyFrame,
 
     /// The frame holds more points than the configured capacity.
     #[error("frame of {points} points exceeds the capacity of {capacity}")]

@@ -1,7 +1,10 @@
-//! Seeded fuzzing of the frame validation: 10^4 bad frames (empty, above
+//! Seeded fuzzing of the frame validation: 10^4 fuzzed frames (empty, above
 //! capacity, every point with a NaN or infinite field, a non-finite or
-//! reversed scan interval), interleaved with good
-//! frames. Never a panic; every bad frame is rejected and counted under its
+//! reversed scan interval), interleaved with good frames. Never a panic.
+//! An empty frame with a valid header is the observation "target not seen"
+//! (crate docs): forwarded empty and counted in `empty_frames` and
+//! `frames_without_target`, never rejected. Every other bad frame (an empty
+//! one with a bad scan interval included) is rejected and counted under its
 //! own reason; every good frame still passes.
 
 use crate::{IngestConfig, IngestError, IngestStage, IngestStats};
@@ -36,9 +39,10 @@ fn non_finite_point(rng: &mut impl Rng, i: usize) -> Point {
     p
 }
 
-/// Which counter a bad frame must land in.
+/// Which counter a fuzzed frame must land in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Reason {
+    /// Valid header, no point: forwarded as "target not seen".
     Empty,
     Oversized,
     NonFinite,
@@ -59,6 +63,8 @@ fn bad_frame(rng: &mut impl Rng) -> (Vec<Point>, f64, f64, Reason) {
             (pts, 0.0, 0.1, Reason::NonFinite)
         }
         _ => {
+            // Some of them empty: a bad header is bad input, points or not.
+            let n = if rng.random_range(0..4) == 0 { 0 } else { n };
             let pts = (0..n).map(|i| finite_point(rng, i)).collect();
             let (a, b) = match rng.random_range(0..4) {
                 0 => (f64::NAN, 0.1),
@@ -72,7 +78,7 @@ fn bad_frame(rng: &mut impl Rng) -> (Vec<Point>, f64, f64, Reason) {
 }
 
 #[test]
-fn ten_thousand_bad_frames_are_rejected_and_counted_by_reason() {
+fn ten_thousand_fuzzed_frames_are_rejected_or_forwarded_and_counted_by_reason() {
     let mut stage = IngestStage::new(IngestConfig {
         max_points: MAX_POINTS,
         ..IngestConfig::default()
@@ -86,10 +92,13 @@ fn ten_thousand_bad_frames_are_rejected_and_counted_by_reason() {
         let (points, start, end, reason) = bad_frame(&mut rng);
         let r = stage.process_into(&points, start, end, None, &mut out);
         match r {
+            Ok(report) if reason == Reason::Empty => {
+                assert_eq!((report.input_points, report.output_points), (0, 0));
+                assert!(!report.target_seen, "frame {i}: {report:?}");
+            }
             Ok(report) => panic!("bad frame {i} ({reason:?}) accepted: {report:?}"),
             Err(e) => {
                 let got = match e {
-                    IngestError::EmptyFrame => Reason::Empty,
                     IngestError::Oversized { .. } => Reason::Oversized,
                     IngestError::AllNonFinite { .. } => Reason::NonFinite,
                     IngestError::BadScanInterval { .. } | IngestError::Voxel(_) => Reason::Other,
@@ -101,7 +110,13 @@ fn ten_thousand_bad_frames_are_rejected_and_counted_by_reason() {
         assert!(out.is_empty());
         expected.frames_in += 1;
         match reason {
-            Reason::Empty => expected.rejected_empty += 1,
+            Reason::Empty => {
+                expected.frames_out += 1;
+                expected.empty_frames += 1;
+                expected.frames_without_target += 1;
+                expected.frames_empty_after_crop += 1;
+                expected.frames_without_prediction += 1;
+            }
             Reason::Oversized => expected.rejected_oversized += 1,
             Reason::NonFinite => {
                 expected.rejected_all_non_finite += 1;
@@ -120,18 +135,26 @@ fn ten_thousand_bad_frames_are_rejected_and_counted_by_reason() {
     }
     let s = *stage.stats();
     assert_eq!(s.frames_in, expected.frames_in + good_frames);
-    assert_eq!(s.frames_out, good_frames);
-    assert_eq!(s.rejected_empty, expected.rejected_empty);
+    assert_eq!(s.frames_out, expected.frames_out + good_frames);
+    assert_eq!(s.empty_frames, expected.empty_frames);
+    assert_eq!(s.frames_without_target, expected.frames_without_target);
+    assert_eq!(s.frames_empty_after_crop, expected.frames_empty_after_crop);
+    assert_eq!(
+        s.frames_without_prediction,
+        expected.frames_without_prediction + good_frames
+    );
     assert_eq!(s.rejected_oversized, expected.rejected_oversized);
     assert_eq!(s.rejected_all_non_finite, expected.rejected_all_non_finite);
     assert_eq!(s.frames_with_non_finite, expected.frames_with_non_finite);
     assert_eq!(s.rejected_other, expected.rejected_other);
-    let rejected =
-        s.rejected_empty + s.rejected_oversized + s.rejected_all_non_finite + s.rejected_other;
-    assert_eq!(rejected, BAD_FRAMES);
+    let rejected = s.rejected_oversized + s.rejected_all_non_finite + s.rejected_other;
+    assert_eq!(rejected + s.empty_frames, BAD_FRAMES);
+    assert!(s.empty_frames > 0 && s.rejected_oversized > 0);
+    assert!(s.rejected_all_non_finite > 0 && s.rejected_other > 0);
     println!(
-        "ingest fuzz: {BAD_FRAMES} bad frames rejected (empty {}, oversized {}, all non-finite {}, \
-         bad interval or voxel {}); {good_frames} good frames between them passed",
-        s.rejected_empty, s.rejected_oversized, s.rejected_all_non_finite, s.rejected_other
+        "ingest fuzz: {BAD_FRAMES} fuzzed frames: {rejected} rejected (oversized {}, all non-finite \
+         {}, bad interval or voxel {}), {} empty ones with a valid header forwarded as \
+         \"target not seen\"; {good_frames} good frames between them passed",
+        s.rejected_oversized, s.rejected_all_non_finite, s.rejected_other, s.empty_frames
     );
 }

@@ -2,12 +2,17 @@
 //! acquisition results; publishes each raw frame cropped to the target's
 //! region of interest and voxel-filtered (same header, new point count),
 //! plus a health heartbeat. Bad frames are logged and counted, never fatal.
+//! A well-formed frame without the target (empty, or too few points after
+//! the crop) is forwarded as it is: "target not seen" is an observation the
+//! tracker must see to report the loss (crate docs of `spacepose_ingest`).
 
 use anyhow::{Context, Result};
 use clap::Parser;
 use serde::Deserialize;
 use spacepose_bus::{Bus, CloudPublisher, CloudSubscriber, Subscriber, WakeReason};
-use spacepose_ingest::{AttitudePrediction, IngestConfig, IngestStage, TargetPrediction};
+use spacepose_ingest::{
+    AttitudePrediction, FrameReport, IngestConfig, IngestStage, TargetPrediction,
+};
 use spacepose_messages::convert::{rotation_from_wxyz, vector3_from_wire};
 use spacepose_messages::{AcquisitionResult, FilterState, Names, ServiceState};
 use spacepose_service_kit::{
@@ -85,6 +90,8 @@ struct Node {
     frames_out: u64,
     last_frame: u64,
     errors: u64,
+    /// Whether the last forwarded frame showed the target (for the log).
+    target_seen: bool,
 }
 
 impl Node {
@@ -102,17 +109,21 @@ impl Node {
             frames_out: 0,
             last_frame: 0,
             errors: 0,
+            target_seen: true,
         })
     }
 
-    /// Health counters: the stage's rejections plus bus errors.
+    /// Health counters: the stage's rejections plus bus errors. Empty
+    /// frames are forwarded (in `frames_out`), so `rejected_empty` stays 0;
+    /// the health message has no field for `frames_without_target` yet (it
+    /// is in the stage's stats and the log).
     fn counters(&self) -> Counters {
         let s = self.stage.stats();
         Counters {
             frames_in: s.frames_in,
             frames_out: self.frames_out,
             rejected_non_finite: s.frames_with_non_finite,
-            rejected_empty: s.rejected_empty,
+            rejected_empty: 0,
             rejected_oversized: s.rejected_oversized,
             rejected_wire: 0,
             errors: s.rejected_other + self.errors,
@@ -150,6 +161,7 @@ impl Node {
                             "dropped {} non-finite points", report.non_finite_points
                         );
                     }
+                    self.log_target_seen(header.sequence, &report);
                     match self.out.send(header, &self.buffer) {
                         Ok(()) => {
                             self.frames_out += 1;
@@ -163,6 +175,30 @@ impl Node {
                 }
                 Err(e) => warn!(sequence = header.sequence, "frame rejected: {e}"),
             }
+        }
+    }
+
+    /// Logs when the target disappears from the frames and when it is back.
+    fn log_target_seen(&mut self, sequence: u64, report: &FrameReport) {
+        if report.target_seen == self.target_seen {
+            return;
+        }
+        self.target_seen = report.target_seen;
+        let without = self.stage.stats().frames_without_target;
+        if report.target_seen {
+            info!(
+                sequence,
+                points = report.output_points,
+                frames_without_target = without,
+                "target seen again"
+            );
+        } else {
+            info!(
+                sequence,
+                input_points = report.input_points,
+                points = report.output_points,
+                "target not seen: forwarding the frame as an observation"
+            );
         }
     }
 

@@ -20,6 +20,9 @@ pub struct FrameReport {
     pub roi_points: usize,
     /// Points out (after voxel filtering).
     pub output_points: usize,
+    /// False when fewer than `IngestConfig::min_target_points` points came
+    /// out: the frame is the observation "target not seen" (still forwarded).
+    pub target_seen: bool,
     /// The region used.
     pub roi: RoiKind,
 }
@@ -75,10 +78,15 @@ impl IngestStage {
 
     /// Processes one frame into `out` (cleared first; left empty on error).
     ///
+    /// A well-formed frame with no point, or with no (or too few) points
+    /// left after the crop, is `Ok` with `out` empty (or small) and
+    /// [`FrameReport::target_seen`] false: the caller forwards it, so that
+    /// the tracker sees the frame and can report the loss at once.
+    ///
     /// # Errors
-    /// [`IngestError::EmptyFrame`], [`IngestError::Oversized`],
-    /// [`IngestError::AllNonFinite`], [`IngestError::BadScanInterval`] or
-    /// [`IngestError::Voxel`]; each is counted in [`IngestStats`].
+    /// [`IngestError::Oversized`], [`IngestError::AllNonFinite`],
+    /// [`IngestError::BadScanInterval`] or [`IngestError::Voxel`]; each is
+    /// counted in [`IngestStats`].
     pub fn process_into(
         &mut self,
         points: &[Point],
@@ -94,7 +102,6 @@ impl IngestStage {
             out.clear();
             let s = &mut self.stats;
             match e {
-                IngestError::EmptyFrame => s.rejected_empty += 1,
                 IngestError::Oversized { .. } => s.rejected_oversized += 1,
                 IngestError::AllNonFinite { .. } => {
                     s.rejected_all_non_finite += 1;
@@ -115,9 +122,6 @@ impl IngestStage {
         out: &mut Vec<Point>,
     ) -> Result<FrameReport, IngestError> {
         let n = points.len();
-        if n == 0 {
-            return Err(IngestError::EmptyFrame);
-        }
         if n > self.config.max_points {
             return Err(IngestError::Oversized {
                 points: n,
@@ -132,7 +136,8 @@ impl IngestStage {
         }
         let (roi, issue) = Roi::for_frame(&self.config, prediction, scan_start_s, scan_end_s);
         let crop = crop_into(&roi, points, &mut self.roi_points);
-        if crop.non_finite == n {
+        // An empty frame (n = 0) is not "all non-finite": it goes through.
+        if n > 0 && crop.non_finite == n {
             return Err(IngestError::AllNonFinite { points: n });
         }
         match &mut self.voxel {
@@ -141,8 +146,11 @@ impl IngestStage {
             }
             None => out.extend_from_slice(&self.roi_points),
         }
+        let target_seen = out.len() >= self.config.min_target_points;
         let s = &mut self.stats;
         s.frames_out += 1;
+        s.empty_frames += u64::from(n == 0);
+        s.frames_without_target += u64::from(!target_seen);
         s.frames_with_non_finite += u64::from(crop.non_finite > 0);
         s.non_finite_points += crop.non_finite as u64;
         s.cropped_points += crop.outside as u64;
@@ -155,6 +163,7 @@ impl IngestStage {
             cropped_points: crop.outside,
             roi_points: self.roi_points.len(),
             output_points: out.len(),
+            target_seen,
             roi: roi.kind(),
         })
     }

@@ -34,9 +34,11 @@ fn stage() -> IngestStage {
 fn bad_frames_are_rejected_counted_and_the_next_frame_still_passes() {
     let mut s = stage();
     let good = cube(2000, 1);
+    // An empty frame with a bad header is bad input (below: with a valid
+    // header it is an observation).
     assert!(matches!(
-        s.process(&[], 0.0, 1.0, None),
-        Err(IngestError::EmptyFrame)
+        s.process(&[], 1.0, 0.5, None),
+        Err(IngestError::BadScanInterval { .. })
     ));
     assert!(matches!(
         s.process(&cube(10_001, 2), 0.0, 1.0, None),
@@ -72,12 +74,40 @@ fn bad_frames_are_rejected_counted_and_the_next_frame_still_passes() {
     let st = *s.stats();
     assert_eq!(st.frames_in, 7);
     assert_eq!(st.frames_out, 2);
-    assert_eq!(st.rejected_empty, 1);
     assert_eq!(st.rejected_oversized, 1);
     assert_eq!(st.rejected_all_non_finite, 1);
-    assert_eq!(st.rejected_other, 2);
+    assert_eq!(st.rejected_other, 3);
     assert_eq!(st.frames_with_non_finite, 2);
     assert_eq!(st.non_finite_points, 3);
+    assert_eq!((st.empty_frames, st.frames_without_target), (0, 0));
+}
+
+#[test]
+fn frames_without_the_target_are_forwarded_as_observations() {
+    let mut s = stage();
+    // The sensor looked away: a well-formed frame with no point.
+    let (out, r) = s.process(&[], 3.0, 4.0, None).unwrap();
+    assert!(out.is_empty());
+    assert_eq!(
+        (r.input_points, r.output_points, r.target_seen),
+        (0, 0, false)
+    );
+    // A few points of the target (fewer than min_target_points = 20).
+    let (out, r) = s.process(&cube(5, 4)[..], 4.0, 5.0, None).unwrap();
+    assert_eq!((out.len(), r.target_seen), (5, false));
+    // Points, but none in the region of interest (a far wall).
+    let wall = vec![Point::new(0.0, 0.0, 80.0, 1.0, 5.5); 300];
+    let (out, r) = s.process(&wall, 5.0, 6.0, None).unwrap();
+    assert!(out.is_empty() && !r.target_seen && r.cropped_points == 300);
+    // The target is back.
+    let (out, r) = s.process(&cube(2000, 5), 6.0, 7.0, None).unwrap();
+    assert!(out.len() >= 20 && r.target_seen);
+    let st = *s.stats();
+    assert_eq!((st.frames_in, st.frames_out), (4, 4));
+    assert_eq!((st.empty_frames, st.frames_without_target), (1, 3));
+    assert_eq!(st.frames_empty_after_crop, 2);
+    let rejected = st.rejected_oversized + st.rejected_all_non_finite + st.rejected_other;
+    assert_eq!(rejected, 0);
 }
 
 #[test]

@@ -6,10 +6,16 @@
 pub struct IngestStats {
     /// Frames offered to [`crate::IngestStage::process`].
     pub frames_in: u64,
-    /// Frames that came out cropped and filtered.
+    /// Frames that came out cropped and filtered (frames without the
+    /// target included: they are observations, not rejections).
     pub frames_out: u64,
-    /// Frames rejected because they held no point.
-    pub rejected_empty: u64,
+    /// Well-formed frames that held no point at all (the sensor saw
+    /// nothing, e.g. it looked away): forwarded as empty clouds, not rejected.
+    pub empty_frames: u64,
+    /// Forwarded frames with fewer than `IngestConfig::min_target_points`
+    /// points after the crop and the voxel filter (empty frames included):
+    /// the observation "target not seen".
+    pub frames_without_target: u64,
     /// Frames rejected because they exceeded `max_points`.
     pub rejected_oversized: u64,
     /// Frames rejected because every point was non-finite.
@@ -26,6 +32,7 @@ pub struct IngestStats {
     pub frames_without_prediction: u64,
     /// Predictions ignored because stale or non-finite.
     pub ignored_predictions: u64,
-    /// Accepted frames with no point left in the region of interest.
+    /// Accepted frames with no point left in the region of interest (empty
+    /// frames included).
     pub frames_empty_after_crop: u64,
 }

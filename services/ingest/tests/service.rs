@@ -91,9 +91,13 @@ fn ingest_crops_counts_bad_frames_and_keeps_going() {
     assert!(!out1.is_empty() && out1.len() < 3600);
     assert!(out1.iter().all(Point::is_finite));
 
-    // 2. An empty frame, 3. an oversized one: counted, nothing published.
+    // 2. An empty frame with a valid header (the sensor saw nothing): an
+    //    observation, forwarded empty with its own header, not rejected.
     raw.send(CloudHeader::new(2, 2.0, 2.5), &[]).unwrap();
-    health_until(&health, "the empty frame", |h| h.rejected_empty == 1);
+    let (h2, out2) = next_cloud(&cloud);
+    assert_eq!((h2.sequence, h2.scan_start_s, h2.scan_end_s), (2, 2.0, 2.5));
+    assert_eq!((h2.point_count, out2.len()), (0, 0));
+    // 3. An oversized frame: counted, nothing published.
     raw.send(CloudHeader::new(3, 3.0, 3.5), &scene(55_000, 3.0))
         .unwrap();
     health_until(&health, "the oversized frame", |h| {
@@ -121,10 +125,10 @@ fn ingest_crops_counts_bad_frames_and_keeps_going() {
         "rejected frames publish nothing"
     );
 
-    let h = health_until(&health, "the final counters", |h| h.frames_out == 2);
+    let h = health_until(&health, "the final counters", |h| h.frames_out == 3);
     assert_eq!(h.frames_in, 4);
     assert_eq!(h.rejected_non_finite, 1);
-    assert_eq!((h.rejected_empty, h.rejected_oversized), (1, 1));
+    assert_eq!((h.rejected_empty, h.rejected_oversized), (0, 1));
     assert_eq!(h.last_frame, 4);
 
     // SIGTERM: a clean exit with a Stopping heartbeat.

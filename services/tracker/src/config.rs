@@ -19,6 +19,15 @@ use spacepose_registration::{IcpParams, NdtParams};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct LossConfig {
+    /// Fewest points after pre-processing (the voxel filter) for a
+    /// registration to be attempted. A cloud with fewer carries no
+    /// measurement (the target is not in view: ingest forwards such frames
+    /// as observations, e.g. when the sensor looks away): the frame is
+    /// declared `lost` at once, not after `max_consecutive_degraded` frames,
+    /// since there is nothing to track, and nothing is fused. >= 1. Default
+    /// 20, the init service's `min_points` (issue 5: under 20 points a cloud
+    /// is too sparse to match).
+    pub min_points: usize,
     /// Fewest inliers for a usable registration.
     pub min_inliers: usize,
     /// Smallest fraction of the filtered points that must find a cell.
@@ -45,6 +54,7 @@ pub struct LossConfig {
 impl Default for LossConfig {
     fn default() -> Self {
         Self {
+            min_points: 20,
             min_inliers: 100,
             min_inlier_fraction: 0.3,
             max_mean_cost_ndt: 10.0,
@@ -143,6 +153,11 @@ impl TrackerConfig {
                 l.min_inlier_fraction,
             ));
         }
+        if l.min_points == 0 {
+            return Err(TrackError::InvalidConfig(
+                "loss.min_points must be >= 1".into(),
+            ));
+        }
         if l.max_consecutive_degraded == 0 {
             return Err(TrackError::InvalidConfig(
                 "loss.max_consecutive_degraded must be >= 1".into(),
@@ -166,6 +181,9 @@ mod tests {
         assert!(c.validate().is_err());
         let mut c = TrackerConfig::default();
         c.loss.max_innovation_rot_deg = f64::NAN;
+        assert!(c.validate().is_err());
+        let mut c = TrackerConfig::default();
+        c.loss.min_points = 0;
         assert!(c.validate().is_err());
     }
 }

@@ -190,7 +190,6 @@ fn drain_clouds(ports: &Ports, node: &mut TrackerNode, counters: &mut Counters) 
 fn count(r: &FrameResult, counters: &mut Counters) {
     let seq = r.estimate.sequence;
     match r.issue {
-        Some(InputIssue::Empty) => counters.rejected_empty += 1,
         Some(InputIssue::Oversized { .. }) => counters.rejected_oversized += 1,
         Some(InputIssue::NonFinite { .. }) => counters.rejected_non_finite += 1,
         None => {}

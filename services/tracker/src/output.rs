@@ -52,6 +52,13 @@ pub struct TrackOutput {
 }
 
 impl TrackOutput {
+    /// False when the frame carried no measurement (too few points to
+    /// register, or the registration failed): the pose is then the filter
+    /// prediction, the status `lost`, and nothing was fused.
+    pub fn has_measurement(&self) -> bool {
+        self.registration.is_some()
+    }
+
     /// Registration iterations (0 when none ran).
     pub fn iterations(&self) -> usize {
         self.registration.as_ref().map_or(0, |r| r.iterations)

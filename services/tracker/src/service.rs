@@ -3,9 +3,18 @@
 //! publish for every frame. `src/main.rs` only moves messages.
 //!
 //! Exactly one `PoseEstimate` is produced per cloud: before initialisation,
-//! for bad input (empty, oversized, all points non-finite) and for frames
-//! the tracker refuses, it is a `lost` estimate, so downstream services
-//! (filter, telemetry, the future init service) see every frame.
+//! for bad input (oversized, all points non-finite) and for frames the
+//! tracker refuses, it is a `lost` estimate, so downstream services
+//! (filter, telemetry, the init service) see every frame.
+//!
+//! An empty cloud (or one below `loss.min_points`) is not bad input: ingest
+//! forwards a well-formed frame without the target as the observation
+//! "target not seen" (e.g. the sensor looked away). The tracker answers it
+//! `lost` at once, with the filter prediction as the pose and no
+//! measurement (zero iterations, inliers and covariance; see
+//! [`crate::wire::fill_estimate`]), and fuses nothing: the init service
+//! sees the loss on the first such frame and acquires on the first frame
+//! with enough points after the gap.
 
 use crate::config::TrackerConfig;
 use crate::error::TrackError;
@@ -25,8 +34,6 @@ use std::borrow::Cow;
 /// Why a frame was not handed to the tracker (or only partly).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum InputIssue {
-    /// No point at all.
-    Empty,
     /// More points than `max_points`.
     Oversized {
         /// Points in the frame.
@@ -271,9 +278,8 @@ impl TrackerNode {
         points: &'a [Point],
         result: &mut FrameResult,
     ) -> Option<Cow<'a, [Point]>> {
-        let issue = if points.is_empty() {
-            InputIssue::Empty
-        } else if points.len() > self.max_points {
+        // An empty cloud is no issue: it goes to the tracker (no measurement).
+        let issue = if points.len() > self.max_points {
             InputIssue::Oversized {
                 points: points.len(),
                 max_points: self.max_points,

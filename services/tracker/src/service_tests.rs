@@ -86,11 +86,6 @@ fn frames_before_initialisation_and_bad_frames_are_lost_but_answered() {
     assert!(r.reason.contains("not initialised"), "{}", r.reason);
     assert!(node.on_acquisition(&truth_acquisition(&f[0])).unwrap());
 
-    let empty = node.on_cloud(&header(1, &f[1]), &[]);
-    assert_eq!(
-        (status(&empty), empty.issue),
-        (WireStatus::Lost, Some(InputIssue::Empty))
-    );
     let nan = vec![Point::new(f32::NAN, 0.0, 1.0, 1.0, f[1].scan_end); 50];
     let r = node.on_cloud(&header(1, &f[1]), &nan);
     assert_eq!(status(&r), WireStatus::Lost);
@@ -294,4 +289,52 @@ fn after_a_loss_an_accepted_acquisition_restarts_the_track_and_a_rejected_one_do
     let (ang, pos) = errors(&r, &f[3]);
     assert!(ang < 1.0 && pos < 0.05, "{ang}° {pos} m");
     assert!(node.is_tracking());
+}
+
+#[test]
+fn a_frame_without_the_target_is_lost_at_once_and_fuses_nothing() {
+    let f = &fixture().frames;
+    for (what, cloud) in [
+        ("empty (sensor looked away)", Vec::new()),
+        ("10 points", f[2].points[..10].to_vec()),
+    ] {
+        let mut node = node();
+        node.on_acquisition(&truth_acquisition(&f[0])).unwrap();
+        node.on_cloud(&header(0, &f[0]), &f[0].points);
+        let r = node.on_cloud(&header(1, &f[1]), &f[1].points);
+        assert_eq!(status(&r), WireStatus::Tracking, "{}", r.reason);
+        let before = node.tracker().predict_at(f[2].scan_end).unwrap();
+
+        // Lost on this very frame (not after 5 degraded ones), and not as
+        // bad input: "target not seen" is an observation.
+        let r = node.on_cloud(&header(2, &f[2]), &cloud);
+        assert_eq!(status(&r), WireStatus::Lost, "{what}");
+        assert!(r.reason.contains("no measurement"), "{what}: {}", r.reason);
+        assert!(r.issue.is_none() && r.error.is_none(), "{what}: {r:?}");
+        assert!(!node.is_tracking());
+        // No measurement on the wire: the pose is the filter prediction,
+        // no registration figures, covariance unknown (zeros).
+        let e = &r.estimate;
+        assert_eq!((e.sequence, e.t_s), (2, f[2].scan_end));
+        assert_eq!((e.iterations, e.inliers), (0, 0), "{what}");
+        assert!(e.points_used as usize <= cloud.len(), "{what}");
+        assert!(e.covariance.iter().flatten().all(|v| *v == 0.0));
+        let (ang, pos) = e.pose().unwrap().error_to(&before.pose);
+        assert!(ang < 1e-6 && pos < 1e-6, "{what}: {ang} rad {pos} m");
+        // Nothing was fused: the filter predicts exactly as before.
+        let after = node.tracker().predict_at(f[2].scan_end).unwrap();
+        let (ang, pos) = after.pose.error_to(&before.pose);
+        assert!(ang < 1e-12 && pos < 1e-12, "{what}: the filter moved");
+        assert_eq!(after.covariance, before.covariance, "{what}");
+        assert_eq!(after.w_target, before.w_target, "{what}");
+
+        // The target is back, but the track waits for a reacquisition...
+        let r = node.on_cloud(&header(3, &f[3]), &f[3].points);
+        assert_eq!(status(&r), WireStatus::Lost, "{what}: {}", r.reason);
+        // ... which restarts it.
+        assert!(node.on_acquisition(&truth_acquisition(&f[2])).unwrap());
+        let r = node.on_cloud(&header(3, &f[3]), &f[3].points);
+        assert_eq!(status(&r), WireStatus::Tracking, "{what}: {}", r.reason);
+        assert!(node.is_tracking());
+    }
 }

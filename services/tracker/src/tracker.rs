@@ -125,6 +125,13 @@ impl Tracker {
     /// degenerate geometry, inconsistency) are *reported* in the output's
     /// status; `Err` is reserved for misuse (not initialised, scan times
     /// not finite or not increasing).
+    ///
+    /// A cloud with fewer than `loss.min_points` points after pre-processing
+    /// (empty included) is no measurement: the target is not in view. It is
+    /// `lost` at once (the degraded-frames rule is for doubtful
+    /// measurements; here there is nothing to track), its pose is the filter
+    /// prediction at the scan end, [`TrackOutput::has_measurement`] is
+    /// false, and nothing is fed to the filter.
     pub fn process(
         &mut self,
         points: &[Point],
@@ -161,6 +168,18 @@ impl Tracker {
             }
         };
         let preprocess_ms = ms(pre);
+        if cloud.len() < self.config.loss.min_points {
+            let reason = format!(
+                "no measurement: {} points after pre-processing, fewer than loss.min_points = {} \
+                 (target not in view)",
+                cloud.len(),
+                self.config.loss.min_points
+            );
+            let mut out = self.declare_lost(&prediction, points.len(), reason, started);
+            out.points_used = cloud.len();
+            out.timings.preprocess_ms = preprocess_ms;
+            return Ok(out);
+        }
         let reg_start = Instant::now();
         let registration = match self.register(&cloud, &prediction, &last, scan_start, scan_end) {
             Ok(r) => r,

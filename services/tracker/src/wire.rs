@@ -51,6 +51,12 @@ pub fn lost_estimate(header: &CloudHeader, instance: Name, mode: TrackingMode) -
 
 /// Fills `e` from the tracker's answer for the frame: pose, status,
 /// covariance (zeros when unknown), registration figures and timings.
+///
+/// A frame without a measurement ([`TrackOutput::has_measurement`] false:
+/// too few points, e.g. the target out of view, or a failed registration)
+/// is `lost` with `iterations == 0`, `inliers == 0`, `cost == 0` and an
+/// all-zero covariance, and its pose is the filter prediction at `t_s`, not
+/// a measurement: the filter service fuses only `tracking` estimates.
 pub fn fill_estimate(e: &mut PoseEstimate, out: &TrackOutput) {
     e.status = status_to_wire(out.status) as u8;
     e.t_s = out.t;
