@@ -161,6 +161,8 @@ pub struct GroundArgs {
 pub enum EvalCommand {
     /// Tracking accuracy and speed per mode, as seed 000 Tables 2-3.
     Tracking(EvalTrackingArgs),
+    /// CNN pose estimation + NDT refinement (seed 004 Tables III-IV) on held-out frames.
+    Cnn(crate::eval::cnn::EvalCnnArgs),
     /// Template-matching acquisition (seed 002 §4): success rate, time, f_CONV.
     Tm(crate::eval::tm::EvalTmArgs),
 }

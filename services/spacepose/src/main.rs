@@ -14,6 +14,7 @@ fn main() -> ExitCode {
         Command::Sim(args) => spacepose::sim_cmd::run(&args),
         Command::Dataset(args) => spacepose::dataset_cmd::run(&args),
         Command::Eval(EvalCommand::Tracking(args)) => spacepose::eval::tracking::run(&args),
+        Command::Eval(EvalCommand::Cnn(args)) => spacepose::eval::cnn::run(&args),
         Command::Eval(EvalCommand::Tm(args)) => spacepose::eval::tm::run(&args),
         Command::Calibrate(command) => spacepose::calibrate::run(&command),
         Command::Up(args) => spacepose::suite::cmd::up(&args),

@@ -2,6 +2,7 @@
 //! never reaches an estimator, except the documented truth initialisation of
 //! the tracker at the first frame (acquisition comes in a later issue).
 
+pub mod cnn;
 pub mod plot;
 pub mod stats;
 pub mod table;

@@ -1,0 +1,596 @@
+//! `spacepose eval cnn`: seed 004's CNN pose estimation with NDT refinement
+//! on a held-out synthetic set, scored against truth as Table III (success
+//! before and after refinement: < 5° with d_sym, Eq. 14, and < 15 cm; mean
+//! errors over the successes) and timed as Table IV (preprocessing,
+//! inference, refinement; one thread).
+//!
+//! Frames come from the training set's generator (`spacepose_cnn::Generator`:
+//! domain-randomised Mid-40 frames at 2.5-20 m with motion blur) with a seed
+//! never used for training (training 1, validation 2, smoke 90). They are
+//! simulated in parallel, chunk by chunk; the estimates then run one after
+//! the other on the calling thread, so the timings are those of one core.
+
+use super::table::{Table, num};
+use crate::common::load_target;
+use crate::eval::stats::median;
+use crate::sim_cmd::progress_bar;
+use anyhow::{Context, Result, bail};
+use clap::{Args, ValueEnum};
+use rayon::prelude::*;
+use serde::Serialize;
+use spacepose_cnn::{
+    CnnEstimator, DEFAULT_MIN_POINTS, DatasetConfig, EstimatorConfig, GeneratedFrame, Generator,
+};
+use spacepose_geometry::{Pose, so3};
+use spacepose_inference::{Engine, find_ort_library};
+use std::path::PathBuf;
+
+/// Success thresholds of seed 004 §V.A.
+pub const SUCCESS_DEG: f64 = 5.0;
+/// Position threshold (cm).
+pub const SUCCESS_CM: f64 = 15.0;
+/// Seeds used for training, validation and the smoke set: refused.
+pub const TRAINING_SEEDS: [u64; 3] = [1, 2, 90];
+/// Frames simulated in parallel before they are estimated in turn.
+const CHUNK: usize = 64;
+
+/// Inference engines.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum EngineArg {
+    /// tract-onnx (pure Rust).
+    Tract,
+    /// ONNX Runtime (build with `--features ort`).
+    Ort,
+}
+
+/// `spacepose eval cnn`.
+#[derive(Debug, Args)]
+pub struct EvalCnnArgs {
+    /// Built-in target or mesh file (the model must be trained for it).
+    #[arg(long, default_value = "deos")]
+    pub target: String,
+    /// Model directory (model.onnx + model.json); default services/cnn/models/<target>.
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Held-out frames.
+    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u64).range(1..))]
+    pub count: u64,
+    /// Seed of the held-out set (never 1, 2 or 90: training, validation, smoke).
+    #[arg(long, default_value_t = 1001)]
+    pub seed: u64,
+    /// Inference engine.
+    #[arg(long, value_enum, default_value = "tract")]
+    pub engine: EngineArg,
+    /// ONNX Runtime library (default: $ORT_DYLIB_PATH or tools/train/.venv's wheel).
+    #[arg(long)]
+    pub ort_library: Option<PathBuf>,
+    /// f_MAX (m²) of the acceptance check (default: the estimator's).
+    #[arg(long)]
+    pub f_max: Option<f64>,
+    /// Wider NDT stages before the final 7.5 cm one (m, comma-separated;
+    /// "none" for the paper's single stage). Default: the estimator's.
+    #[arg(long)]
+    pub ndt_stages: Option<String>,
+    /// Points kept for the refinement (0 = all). Default: the estimator's.
+    #[arg(long)]
+    pub max_points: Option<usize>,
+    /// Threads simulating the frames (default: all cores); estimates use one.
+    #[arg(long)]
+    pub sim_threads: Option<usize>,
+    /// Write the report as JSON.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Also list every frame.
+    #[arg(long)]
+    pub frames: bool,
+}
+
+/// One held-out frame, scored.
+#[derive(Debug, Clone, Serialize)]
+pub struct CnnFrame {
+    /// Frame index.
+    pub frame: u64,
+    /// True range of the centre of mass (m).
+    pub range_m: f64,
+    /// Points in the frame.
+    pub points: usize,
+    /// Attitude error of the network's pose (deg, d_sym).
+    pub raw_err_deg: f64,
+    /// Position error of the network's pose (cm).
+    pub raw_err_cm: f64,
+    /// Attitude error after refinement (deg, d_sym).
+    pub err_deg: f64,
+    /// Position error after refinement (cm).
+    pub err_cm: f64,
+    /// Raw pose within 5° and 15 cm.
+    pub success_raw: bool,
+    /// Refined pose within 5° and 15 cm.
+    pub success_refined: bool,
+    /// f_CONV (m²).
+    pub f_conv_m2: f64,
+    /// f_CONV ≤ f_MAX.
+    pub accepted: bool,
+    /// Probability of the top class.
+    pub top_probability: f32,
+    /// Run time split (ms).
+    pub time_ms: spacepose_cnn::Timings,
+    /// Of the refinement: the f_CONV ICP (ms).
+    pub fconv_ms: f64,
+    /// The estimator's error or the refinement's, if any.
+    pub error: Option<String>,
+}
+
+/// Mean ± standard deviation over the successes (Table III).
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct MeanStd {
+    /// Mean.
+    pub mean: f64,
+    /// Standard deviation.
+    pub std: f64,
+}
+
+impl MeanStd {
+    fn of(values: &[f64]) -> Self {
+        let n = values.len() as f64;
+        if values.is_empty() {
+            return Self {
+                mean: f64::NAN,
+                std: f64::NAN,
+            };
+        }
+        let mean = values.iter().sum::<f64>() / n;
+        let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
+        Self {
+            mean,
+            std: var.sqrt(),
+        }
+    }
+}
+
+/// Errors before and after refinement.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct RawRefined {
+    /// Network pose, over its successes.
+    pub raw: MeanStd,
+    /// Refined pose, over its successes.
+    pub refined: MeanStd,
+}
+
+/// Median, mean and standard deviation of a time (ms).
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct TimeStats {
+    /// Median.
+    pub median: f64,
+    /// Mean.
+    pub mean: f64,
+    /// Standard deviation.
+    pub std: f64,
+    /// 95th percentile.
+    pub p95: f64,
+}
+
+impl TimeStats {
+    fn of(values: &[f64]) -> Self {
+        let MeanStd { mean, std } = MeanStd::of(values);
+        let mut sorted = values.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        let p95 = sorted
+            .get(((sorted.len() as f64 * 0.95) as usize).min(sorted.len().saturating_sub(1)))
+            .copied()
+            .unwrap_or(f64::NAN);
+        Self {
+            median: median(values),
+            mean,
+            std,
+            p95,
+        }
+    }
+}
+
+/// Table IV.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct TimeSplit {
+    /// Finite-point filter, trimmed centroid, depth image.
+    pub preprocess: TimeStats,
+    /// Network and Γ_sym.
+    pub inference: TimeStats,
+    /// Voxel filter, NDT, f_CONV ICP.
+    pub refinement: TimeStats,
+    /// Everything.
+    pub total: TimeStats,
+}
+
+/// f_CONV over successes and failures (seed 002 Table 4), to choose f_MAX.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct FconvStats {
+    /// f_MAX used (m²).
+    pub f_max_m2: f64,
+    /// Accepted over frames.
+    pub accepted_rate: f64,
+    /// Accepted failures (a wrong pose handed to the tracker).
+    pub false_accepts: usize,
+    /// Rejected successes (template matching would be tried needlessly).
+    pub false_rejects: usize,
+    /// Largest f_CONV of a refined success (m²).
+    pub success_max_m2: f64,
+    /// Median f_CONV of the successes.
+    pub success_median_m2: f64,
+    /// Smallest f_CONV of a refined failure (m²).
+    pub failure_min_m2: f64,
+    /// Median f_CONV of the failures.
+    pub failure_median_m2: f64,
+}
+
+/// Success by range.
+#[derive(Debug, Clone, Serialize)]
+pub struct RangeBin {
+    /// Range interval (m).
+    pub range_m: [f64; 2],
+    /// Frames in it.
+    pub frames: usize,
+    /// Refined successes over frames.
+    pub success_rate_refined: f64,
+    /// Raw successes over frames.
+    pub success_rate_raw: f64,
+}
+
+/// Summary of an `eval cnn` run.
+#[derive(Debug, Clone, Serialize)]
+pub struct CnnReport {
+    /// Target name.
+    pub target: String,
+    /// Model directory.
+    pub model: String,
+    /// Engine (`tract` or `ort`).
+    pub engine: String,
+    /// Seed of the held-out set.
+    pub seed: u64,
+    /// Frames.
+    pub count: usize,
+    /// Refined successes over frames.
+    pub success_rate_refined: f64,
+    /// Network successes over frames.
+    pub success_rate_raw: f64,
+    /// Attitude errors over the successes (deg).
+    pub ang_err_deg: RawRefined,
+    /// Position errors over the successes (cm).
+    pub pos_err_cm: RawRefined,
+    /// Run time split (ms), one thread.
+    pub time_ms: TimeSplit,
+    /// Acceptance check.
+    pub fconv: FconvStats,
+    /// Success by range.
+    pub by_range: Vec<RangeBin>,
+    /// Estimator errors (counted as failures).
+    pub errors: usize,
+    /// Mean points per frame.
+    pub mean_points: f64,
+    /// Estimator settings.
+    pub config: EstimatorConfig,
+    /// Every frame.
+    pub frames: Vec<CnnFrame>,
+}
+
+fn engine(args: &EvalCnnArgs) -> Result<Engine> {
+    Ok(match args.engine {
+        EngineArg::Tract => Engine::Tract,
+        EngineArg::Ort => Engine::Ort {
+            library: match &args.ort_library {
+                Some(p) => p.clone(),
+                None => find_ort_library()?,
+            },
+        },
+    })
+}
+
+/// Errors of `estimate` against the truth: (deg with d_sym, cm).
+fn errors(estimate: &Pose, truth: &Pose, syms: &[nalgebra::Rotation3<f64>]) -> (f64, f64) {
+    let deg = so3::distance_sym(&estimate.rotation, &truth.rotation, syms).to_degrees();
+    let cm = (estimate.translation - truth.translation).norm() * 100.0;
+    (deg, cm)
+}
+
+fn score(estimator: &CnnEstimator, index: u64, f: &GeneratedFrame) -> CnnFrame {
+    let truth = &f.truth.t_sensor_target;
+    let syms = estimator.classes().symmetries();
+    let mut row = CnnFrame {
+        frame: index,
+        range_m: truth.translation.norm(),
+        points: f.points.len(),
+        raw_err_deg: f64::NAN,
+        raw_err_cm: f64::NAN,
+        err_deg: f64::NAN,
+        err_cm: f64::NAN,
+        success_raw: false,
+        success_refined: false,
+        f_conv_m2: f64::INFINITY,
+        accepted: false,
+        top_probability: 0.0,
+        time_ms: spacepose_cnn::Timings::default(),
+        fconv_ms: f64::NAN,
+        error: None,
+    };
+    match estimator.estimate(&f.points) {
+        Ok(e) => {
+            (row.raw_err_deg, row.raw_err_cm) = errors(&e.t_sensor_target_raw, truth, syms);
+            row.success_raw = row.raw_err_deg < SUCCESS_DEG && row.raw_err_cm < SUCCESS_CM;
+            if e.refinement_error.is_none() {
+                (row.err_deg, row.err_cm) = errors(&e.t_sensor_target, truth, syms);
+                row.success_refined = row.err_deg < SUCCESS_DEG && row.err_cm < SUCCESS_CM;
+            }
+            row.f_conv_m2 = e.f_conv_m2;
+            row.accepted = e.accepted;
+            row.top_probability = e.top_probability;
+            row.time_ms = e.time_ms;
+            row.fconv_ms = e.fconv_ms;
+            row.error = e.refinement_error;
+        }
+        Err(e) => row.error = Some(e.to_string()),
+    }
+    row
+}
+
+/// Generates the held-out set and scores every estimate.
+pub fn evaluate(args: &EvalCnnArgs) -> Result<CnnReport> {
+    if TRAINING_SEEDS.contains(&args.seed) {
+        bail!(
+            "seed {} was used for training, validation or smoke tests ({TRAINING_SEEDS:?}): pick another",
+            args.seed
+        );
+    }
+    let target = load_target(&args.target, 1.0)?;
+    let model = args
+        .model
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("services/cnn/models").join(target.name()));
+    let mut config = EstimatorConfig::default();
+    if let Some(f_max) = args.f_max {
+        config.refinement.f_max_m2 = f_max;
+    }
+    if let Some(max_points) = args.max_points {
+        config.refinement.max_points = max_points;
+    }
+    if let Some(stages) = &args.ndt_stages {
+        config.refinement.ndt_stages_m = if stages == "none" {
+            Vec::new()
+        } else {
+            stages
+                .split(',')
+                .map(|s| s.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .with_context(|| format!("--ndt-stages {stages:?}"))?
+        };
+    }
+    let estimator = CnnEstimator::load_with(&model, engine(args)?, target.clone(), config.clone())
+        .with_context(|| format!("loading the CNN from {}", model.display()))?;
+    let generator = Generator::new(
+        target.clone(),
+        DatasetConfig {
+            seed: args.seed,
+            count: args.count as usize,
+            image_size: estimator.preprocess_config().image_size,
+            roll_step_deg: config.roll_step_deg,
+            min_points: DEFAULT_MIN_POINTS,
+        },
+    )?;
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = args.sim_threads {
+        pool = pool.num_threads(t);
+    }
+    let pool = pool
+        .build()
+        .context("cannot start the simulation threads")?;
+    let bar = progress_bar(args.count, "cnn");
+    let mut frames = Vec::with_capacity(args.count as usize);
+    for start in (0..args.count).step_by(CHUNK) {
+        let end = (start + CHUNK as u64).min(args.count);
+        let chunk: Vec<GeneratedFrame> = pool.install(|| {
+            (start..end)
+                .into_par_iter()
+                .map(|i| generator.frame(i))
+                .collect::<Result<_, _>>()
+        })?;
+        for (i, f) in (start..end).zip(&chunk) {
+            frames.push(score(&estimator, i, f));
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    Ok(report(args, &estimator, &model, config, frames))
+}
+
+fn report(
+    args: &EvalCnnArgs,
+    estimator: &CnnEstimator,
+    model: &std::path::Path,
+    config: EstimatorConfig,
+    frames: Vec<CnnFrame>,
+) -> CnnReport {
+    let n = frames.len().max(1) as f64;
+    let rate = |f: &dyn Fn(&CnnFrame) -> bool| frames.iter().filter(|r| f(r)).count() as f64 / n;
+    let over = |ok: &dyn Fn(&CnnFrame) -> bool, v: &dyn Fn(&CnnFrame) -> f64| {
+        MeanStd::of(&frames.iter().filter(|r| ok(r)).map(v).collect::<Vec<_>>())
+    };
+    let ok: Vec<&CnnFrame> = frames.iter().filter(|r| r.error.is_none()).collect();
+    let time =
+        |f: &dyn Fn(&CnnFrame) -> f64| TimeStats::of(&ok.iter().map(|r| f(r)).collect::<Vec<_>>());
+    let fconv = |succ: bool| -> Vec<f64> {
+        frames
+            .iter()
+            .filter(|r| r.success_refined == succ && r.f_conv_m2.is_finite())
+            .map(|r| r.f_conv_m2)
+            .collect()
+    };
+    let (s, f) = (fconv(true), fconv(false));
+    let by_range = [2.5, 5.0, 10.0, 15.0, 20.0]
+        .windows(2)
+        .map(|w| {
+            let bin: Vec<&CnnFrame> = frames
+                .iter()
+                .filter(|r| r.range_m >= w[0] && (r.range_m < w[1] || w[1] >= 20.0))
+                .collect();
+            let k = bin.len().max(1) as f64;
+            RangeBin {
+                range_m: [w[0], w[1]],
+                frames: bin.len(),
+                success_rate_refined: bin.iter().filter(|r| r.success_refined).count() as f64 / k,
+                success_rate_raw: bin.iter().filter(|r| r.success_raw).count() as f64 / k,
+            }
+        })
+        .collect();
+    CnnReport {
+        target: args.target.clone(),
+        model: model.display().to_string(),
+        engine: estimator.engine().to_string(),
+        seed: args.seed,
+        count: frames.len(),
+        success_rate_refined: rate(&|r| r.success_refined),
+        success_rate_raw: rate(&|r| r.success_raw),
+        ang_err_deg: RawRefined {
+            raw: over(&|r| r.success_raw, &|r| r.raw_err_deg),
+            refined: over(&|r| r.success_refined, &|r| r.err_deg),
+        },
+        pos_err_cm: RawRefined {
+            raw: over(&|r| r.success_raw, &|r| r.raw_err_cm),
+            refined: over(&|r| r.success_refined, &|r| r.err_cm),
+        },
+        time_ms: TimeSplit {
+            preprocess: time(&|r| r.time_ms.preprocess),
+            inference: time(&|r| r.time_ms.inference),
+            refinement: time(&|r| r.time_ms.refinement),
+            total: time(&|r| r.time_ms.total),
+        },
+        fconv: FconvStats {
+            f_max_m2: estimator.f_max_m2(),
+            accepted_rate: rate(&|r| r.accepted),
+            false_accepts: frames
+                .iter()
+                .filter(|r| r.accepted && !r.success_refined)
+                .count(),
+            false_rejects: frames
+                .iter()
+                .filter(|r| !r.accepted && r.success_refined)
+                .count(),
+            success_max_m2: s.iter().copied().fold(f64::NAN, f64::max),
+            success_median_m2: median(&s),
+            failure_min_m2: f.iter().copied().fold(f64::NAN, f64::min),
+            failure_median_m2: median(&f),
+        },
+        by_range,
+        errors: frames.iter().filter(|r| r.error.is_some()).count(),
+        mean_points: frames.iter().map(|r| r.points as f64).sum::<f64>() / n,
+        config,
+        frames,
+    }
+}
+
+/// Prints Tables III and IV.
+pub fn print(report: &CnnReport, frames: bool) {
+    println!(
+        "CNN pose estimation, {} held-out frames (seed {}), target {}, model {}, engine {} (one thread); \
+         mean {:.0} points per frame; {} estimator errors",
+        report.count,
+        report.seed,
+        report.target,
+        report.model,
+        report.engine,
+        report.mean_points,
+        report.errors
+    );
+    let pct = |v: f64| num(100.0 * v, 1);
+    let ms = |m: MeanStd, d| format!("{} ± {}", num(m.mean, d), num(m.std, d));
+    let mut t3 = Table::new(&[
+        "step",
+        "success [%]",
+        "position error [cm]",
+        "angular error [deg]",
+    ]);
+    t3.row(vec![
+        "before refinement".into(),
+        pct(report.success_rate_raw),
+        ms(report.pos_err_cm.raw, 1),
+        ms(report.ang_err_deg.raw, 2),
+    ]);
+    t3.row(vec![
+        "after refinement".into(),
+        pct(report.success_rate_refined),
+        ms(report.pos_err_cm.refined, 1),
+        ms(report.ang_err_deg.refined, 2),
+    ]);
+    println!(
+        "\nTable III (success: < {SUCCESS_DEG}° with d_sym and < {SUCCESS_CM} cm; errors over the successes)"
+    );
+    print!("{}", t3.render());
+    let mut t4 = Table::new(&["step", "median [ms]", "mean ± std [ms]", "p95 [ms]"]);
+    let t = &report.time_ms;
+    for (name, s) in [
+        ("preprocessing", t.preprocess),
+        ("CNN inference", t.inference),
+        ("NDT refinement", t.refinement),
+        ("total", t.total),
+    ] {
+        t4.row(vec![
+            name.into(),
+            num(s.median, 2),
+            format!("{} ± {}", num(s.mean, 2), num(s.std, 2)),
+            num(s.p95, 2),
+        ]);
+    }
+    println!("\nTable IV (one thread)");
+    print!("{}", t4.render());
+    let f = &report.fconv;
+    println!(
+        "\nf_CONV check (f_MAX {:.2e} m²): accepted {}%, false accepts {}, false rejects {}; \
+         successes max {:.2e} median {:.2e} m², failures min {:.2e} median {:.2e} m²",
+        f.f_max_m2,
+        pct(f.accepted_rate),
+        f.false_accepts,
+        f.false_rejects,
+        f.success_max_m2,
+        f.success_median_m2,
+        f.failure_min_m2,
+        f.failure_median_m2
+    );
+    let mut bins = Table::new(&["range [m]", "frames", "raw [%]", "refined [%]"]);
+    for b in &report.by_range {
+        bins.row(vec![
+            format!("{}-{}", b.range_m[0], b.range_m[1]),
+            b.frames.to_string(),
+            pct(b.success_rate_raw),
+            pct(b.success_rate_refined),
+        ]);
+    }
+    print!("\n{}", bins.render());
+    if frames {
+        let mut all = Table::new(&[
+            "frame", "range", "points", "raw deg", "raw cm", "deg", "cm", "f_conv", "ok", "ms",
+        ]);
+        for r in &report.frames {
+            all.row(vec![
+                r.frame.to_string(),
+                num(r.range_m, 1),
+                r.points.to_string(),
+                num(r.raw_err_deg, 2),
+                num(r.raw_err_cm, 1),
+                num(r.err_deg, 2),
+                num(r.err_cm, 1),
+                format!("{:.1e}", r.f_conv_m2),
+                r.success_refined.to_string(),
+                num(r.time_ms.total, 1),
+            ]);
+        }
+        print!("\n{}", all.render());
+    }
+}
+
+/// Runs the command.
+pub fn run(args: &EvalCnnArgs) -> Result<()> {
+    let report = evaluate(args)?;
+    print(&report, args.frames);
+    if let Some(path) = &args.json {
+        std::fs::write(path, serde_json::to_string_pretty(&report)?)
+            .with_context(|| format!("writing {}", path.display()))?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
