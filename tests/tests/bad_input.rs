@@ -1,7 +1,10 @@
 //! Bad input driven through the bus into a running suite: a frame of NaN
-//! points, an empty frame, a frame larger than the capacity, and garbage on
-//! the zenoh command key. Each is logged and counted in health, nothing
-//! crashes, and the frames that follow still get their pose.
+//! points, a frame larger than the capacity, and garbage on the zenoh
+//! command key. Each is logged and counted in health, nothing crashes, and
+//! the frames that follow still get their pose. (An empty frame with a
+//! valid header is not bad input: it is the observation "target not seen",
+//! forwarded by ingest and answered `lost` by the tracker; see
+//! `fuzz_input.rs` and `reacquire.rs`.)
 #![allow(clippy::unwrap_used)] // test helpers
 
 use spacepose_bus::zenoh::Wait;
@@ -107,8 +110,6 @@ fn bad_input_is_counted_and_the_next_frames_still_get_poses() {
     let header = |k: u64| CloudHeader::new(bad_seq + k, 0.0, 0.1);
     injector.send(header(0), &vec![nan; 500]).unwrap();
     std::thread::sleep(Duration::from_millis(150));
-    injector.send(header(1), &[]).unwrap();
-    std::thread::sleep(Duration::from_millis(150));
     let far = Point::new(0.0, 0.0, 15.0, 0.5, 0.05);
     injector
         .send(header(2), &vec![far; MAX_POINTS + 1])
@@ -120,9 +121,7 @@ fn bad_input_is_counted_and_the_next_frames_still_get_poses() {
         let Some(ingest) = w.latest.values().find(|h| h.service.as_str() == "ingest") else {
             return false;
         };
-        ingest.rejected_non_finite >= 1
-            && ingest.rejected_empty >= 1
-            && ingest.rejected_oversized >= 1
+        ingest.rejected_non_finite >= 1 && ingest.rejected_oversized >= 1
     });
     // Every frame after the injections still gets its pose, then all of them.
     w.wait_until("a pose for every frame", Duration::from_secs(90), |w| {
@@ -157,8 +156,8 @@ fn bad_input_is_counted_and_the_next_frames_still_get_poses() {
     assert!(!status_text.contains("no heartbeat"), "{status_text}");
     let ingest = w.health_of("ingest");
     println!(
-        "ingest: non-finite {} empty {} oversized {}; status:\n{status_text}",
-        ingest.rejected_non_finite, ingest.rejected_empty, ingest.rejected_oversized
+        "ingest: non-finite {} oversized {}; status:\n{status_text}",
+        ingest.rejected_non_finite, ingest.rejected_oversized
     );
 
     let down = spacepose(&["down", "--prefix", &prefix]);

@@ -1,13 +1,17 @@
 //! Fuzzed input through the real binaries: 10^4 garbage payloads on the
 //! zenoh command key of `spacepose-telemetry` (random bytes, truncated,
 //! trailing bytes, wrong magic, version, kind or schema field, oversized,
-//! non-finite poses, bit flips of valid commands) and 2000 bad raw clouds
-//! into `spacepose-ingest` (empty, above capacity, every point non-finite,
-//! non-finite or reversed scan interval). Both services stay alive, and
-//! their health counters equal what was sent: every payload the codec
-//! refuses is in telemetry's `rejected_wire`, every valid one (a bit flip
-//! can stay valid) reaches the iceoryx2 command topic; every bad cloud is
-//! in ingest's counter for its reason, and none comes out.
+//! non-finite poses, bit flips of valid commands) and 2000 fuzzed raw
+//! clouds into `spacepose-ingest` (empty, above capacity, every point
+//! non-finite, non-finite or reversed scan interval). Both services stay
+//! alive, and their health counters equal what was sent: every payload the
+//! codec refuses is in telemetry's `rejected_wire`, every valid one (a bit
+//! flip can stay valid) reaches the iceoryx2 command topic; every bad cloud
+//! is in ingest's counter for its reason, and none comes out. An empty cloud
+//! with a valid header is not bad input but the observation "target not
+//! seen" (the sensor looked away; `spacepose_ingest` crate docs): each one
+//! comes out as an empty cloud with its own header, counted in `frames_out`,
+//! and `rejected_empty` stays 0.
 #![allow(clippy::unwrap_used)] // test helpers
 
 use rand::{Rng, RngExt, SeedableRng};
@@ -233,6 +237,8 @@ fn bad_cloud(rng: &mut impl Rng) -> (Vec<Point>, f64, f64, CloudReason) {
             (pts, 0.0, 0.1, CloudReason::NonFinite)
         }
         _ => {
+            // Some of them empty: a bad header is bad input, points or not.
+            let n = if rng.random_range(0..4) == 0 { 0 } else { n };
             let (a, b) =
                 [(f64::NAN, 0.1), (0.0, f64::INFINITY), (0.3, 0.1)][rng.random_range(0..3)];
             (
@@ -262,6 +268,7 @@ fn ten_thousand_garbage_payloads_and_bad_clouds_are_refused_counted_and_survived
     let raw = bus
         .cloud_publisher(&names.raw_cloud(), 4 * INGEST_MAX_POINTS)
         .unwrap();
+    let cropped = bus.cloud_subscriber(&names.cloud()).unwrap();
     let mut beats = Beats {
         health: bus.subscriber::<Health>(&names.health()).unwrap(),
         latest: HashMap::new(),
@@ -368,6 +375,19 @@ fn ten_thousand_garbage_payloads_and_bad_clouds_are_refused_counted_and_survived
     // --- iceoryx2: bad raw clouds into ingest ------------------------------
     let before = beats.of("ingest");
     let mut expected: HashMap<&str, u64> = HashMap::new();
+    // (sequence, scan start, scan end) of the empty clouds sent and received.
+    let (mut empty_sent, mut empty_out) = (Vec::new(), Vec::new());
+    let drain_cropped = |out: &mut Vec<(u64, f64, f64)>| {
+        while let Some(c) = cropped.try_recv().unwrap() {
+            let h = *c.header();
+            assert_eq!(
+                (h.point_count, c.len()),
+                (0, 0),
+                "a non-empty cloud came out"
+            );
+            out.push((h.sequence, h.scan_start_s, h.scan_end_s));
+        }
+    };
     let started = Instant::now();
     for seq in 0..BAD_CLOUDS {
         // At most two frames in flight (the subscriber buffer): wait for
@@ -383,18 +403,39 @@ fn ten_thousand_garbage_payloads_and_bad_clouds_are_refused_counted_and_survived
             CloudReason::BadInterval => "errors",
         };
         *expected.entry(name).or_default() += 1;
+        if reason == CloudReason::Empty {
+            empty_sent.push((seq, start_s, end_s));
+        }
         raw.send(CloudHeader::new(seq, start_s, end_s), &points)
             .unwrap();
+        // Each empty cloud is collected before the next one is sent (the
+        // subscriber buffers two clouds; nothing else comes out).
+        if reason == CloudReason::Empty {
+            let deadline = Instant::now() + Duration::from_secs(10);
+            while empty_out.len() < empty_sent.len() {
+                assert!(Instant::now() < deadline, "empty cloud {seq} not forwarded");
+                std::thread::sleep(Duration::from_micros(200));
+                drain_cropped(&mut empty_out);
+            }
+        }
     }
     beats.wait("ingest to take every frame", Duration::from_secs(30), |l| {
         l["ingest"].frames_in >= before.frames_in + BAD_CLOUDS
     });
     let clouds_s = started.elapsed().as_secs_f64();
     let i = beats.of("ingest");
+    drain_cropped(&mut empty_out);
     let e = |k: &str| expected.get(k).copied().unwrap_or(0);
     assert_eq!(i.frames_in - before.frames_in, BAD_CLOUDS);
-    assert_eq!(i.frames_out, before.frames_out, "a bad cloud came out");
-    assert_eq!(i.rejected_empty - before.rejected_empty, e("empty"));
+    // Empty clouds with a valid header: forwarded, each with its own header.
+    assert!(e("empty") > 0);
+    assert_eq!(
+        i.frames_out - before.frames_out,
+        e("empty"),
+        "only the empty clouds come out"
+    );
+    assert_eq!(empty_out, empty_sent, "the empty clouds as sent");
+    assert_eq!(i.rejected_empty, before.rejected_empty);
     assert_eq!(
         i.rejected_oversized - before.rejected_oversized,
         e("oversized")
@@ -406,7 +447,9 @@ fn ten_thousand_garbage_payloads_and_bad_clouds_are_refused_counted_and_survived
     assert_eq!(i.errors - before.errors, e("errors"));
     assert_eq!(i.state, ServiceState::Running as u8);
     println!(
-        "ingest: {BAD_CLOUDS} bad clouds in {clouds_s:.1} s, all refused and counted: {expected:?}"
+        "ingest: {BAD_CLOUDS} fuzzed clouds in {clouds_s:.1} s: {} empty ones with a valid header \
+         forwarded empty with their header, every other one refused and counted: {expected:?}",
+        empty_out.len()
     );
 
     // Both alive, and ingest still passes a good frame.
@@ -418,7 +461,7 @@ fn ten_thousand_garbage_payloads_and_bad_clouds_are_refused_counted_and_survived
     beats.wait(
         "a good frame through ingest",
         Duration::from_secs(10),
-        |l| l["ingest"].frames_out == before.frames_out + 1,
+        |l| l["ingest"].frames_out == before.frames_out + e("empty") + 1,
     );
     assert!(telemetry.0.try_wait().unwrap().is_none(), "telemetry died");
     assert!(ingest.0.try_wait().unwrap().is_none(), "ingest died");
