@@ -42,11 +42,45 @@ pub fn refine(
         t_target_sensor = r.t_target_sensor;
     }
     let r = register_icp(model, cloud, &t_target_sensor, &config.icp)?;
+    let f_conv_m2 = if config.robust_f_conv {
+        truncated_f_conv(
+            r.inlier_fraction(),
+            r.mean_squared_distance_m2,
+            config.icp.max_distance_m,
+        )
+    } else {
+        r.f_conv_m2.unwrap_or(f64::INFINITY)
+    };
     Ok(Refined {
         t_sensor_target: r.t_sensor_target(),
-        f_conv_m2: r.f_conv_m2.unwrap_or(f64::INFINITY),
+        f_conv_m2,
         iterations: iterations + r.iterations,
         converged: r.converged,
         inlier_fraction: r.inlier_fraction(),
     })
+}
+
+/// Truncated f_CONV (departure from seed 002 §4.5, see
+/// [`TemplateMatchingConfig::robust_f_conv`]): the mean over every point of
+/// `min(d², d_max²)`, from the inlier fraction `w` and the inlier mean
+/// squared distance: `w · msd + (1 − w) · d_max²`.
+pub fn truncated_f_conv(inlier_fraction: f64, inlier_msd_m2: f64, max_distance_m: f64) -> f64 {
+    let w = inlier_fraction.clamp(0.0, 1.0);
+    w * inlier_msd_m2 + (1.0 - w) * max_distance_m * max_distance_m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::truncated_f_conv;
+
+    #[test]
+    fn truncated_f_conv_caps_outliers_and_penalises_few_inliers() {
+        // 2 % ghosts barely move a good fit...
+        let good = truncated_f_conv(0.98, 1e-5, 0.1);
+        assert!(good < 3e-4, "{good}");
+        // ...while a wrong pose with half the points out stays high.
+        let bad = truncated_f_conv(0.5, 2e-3, 0.1);
+        assert!(bad > 10.0 * good, "{bad} vs {good}");
+        assert!((truncated_f_conv(0.0, 0.0, 0.1) - 0.01).abs() < 1e-12);
+    }
 }
