@@ -68,6 +68,11 @@ pub struct ZenohOverrideArgs {
 pub struct UpArgs {
     /// Deployment descriptor (TOML), e.g. deploy/demo.toml.
     pub deploy: PathBuf,
+    /// Start only this host's part of a partitioned descriptor (its
+    /// services and its bridge, under the host's local prefix), e.g.
+    /// `--host b` with deploy/partitioned.toml.
+    #[arg(long)]
+    pub host: Option<String>,
     /// Overrides.
     #[command(flatten)]
     pub overrides: ZenohOverrideArgs,

@@ -12,6 +12,14 @@ fn overrides(a: &ZenohOverrideArgs) -> Overrides {
         prefix: a.prefix.clone(),
         listen: (!a.listen.is_empty()).then(|| a.listen.clone()),
         connect: (!a.connect.is_empty()).then(|| a.connect.clone()),
+        host: None,
+    }
+}
+
+fn up_overrides(a: &UpArgs) -> Overrides {
+    Overrides {
+        host: a.host.clone(),
+        ..overrides(&a.overrides)
     }
 }
 
@@ -24,12 +32,12 @@ fn seconds(name: &str, s: f64) -> Result<Duration> {
 
 /// `spacepose up`.
 pub fn up(a: &UpArgs) -> Result<()> {
-    super::up::run(&a.deploy, &overrides(&a.overrides), &mut std::io::stdout())
+    super::up::run(&a.deploy, &up_overrides(a), &mut std::io::stdout())
 }
 
 /// `spacepose supervise` (started by `up`).
 pub fn supervise(a: &UpArgs) -> Result<()> {
-    super::up::supervise(&a.deploy, &overrides(&a.overrides))
+    super::up::supervise(&a.deploy, &up_overrides(a))
 }
 
 /// `spacepose swap`.

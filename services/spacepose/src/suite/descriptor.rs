@@ -12,6 +12,10 @@
 //! ```
 //! Unknown keys are errors at every level except inside `config`, which the
 //! service's own binary checks (`--check`).
+//!
+//! A partitioned deployment (`deploy/partitioned.toml`) adds `[[host]]`
+//! tables, a `host = "..."` on every service and an optional `[link]`;
+//! `spacepose up --host NAME` starts one host's part ([`super::partition`]).
 
 use super::kind::ServiceKind;
 use super::restart::{Policy, RestartSettings};
@@ -47,6 +51,63 @@ pub struct Descriptor {
     /// The service instances.
     #[serde(default, rename = "service")]
     pub services: Vec<ServiceEntry>,
+    /// Hosts of a partitioned deployment (none: everything on one host).
+    #[serde(default, rename = "host")]
+    pub hosts: Vec<HostEntry>,
+    /// The zenoh link between the hosts of a partitioned deployment.
+    #[serde(default)]
+    pub link: LinkSettings,
+}
+
+/// One host of a partitioned deployment: where its bridge joins the link.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HostEntry {
+    /// Host name (`[a-z0-9-]`, 1-12 characters), as in the services' `host`.
+    pub name: String,
+    /// Local deployment prefix of the host's part: its iceoryx2 prefix,
+    /// run directory and `--prefix` of `status`/`down`. Default
+    /// `{prefix}-{name}`. Give the ground host the suite prefix to keep the
+    /// telemetry keys `spacepose/{prefix}/telemetry/...`.
+    #[serde(default)]
+    pub prefix: Option<String>,
+    /// zenoh mode of the host's bridge: `peer`, `client` or `router`
+    /// (peers do not relay since zenoh 1.9: one router in the middle, or
+    /// every pair of hosts linked directly).
+    #[serde(default = "default_mode")]
+    pub mode: String,
+    /// Endpoints the host's bridge listens on.
+    #[serde(default)]
+    pub listen: Vec<String>,
+    /// Endpoints the host's bridge connects to.
+    #[serde(default)]
+    pub connect: Vec<String>,
+    /// The account (`user:password` file) this host presents to the hosts
+    /// it connects to. Relative to the descriptor's directory.
+    #[serde(default)]
+    pub credentials_file: Option<PathBuf>,
+    /// Wait up to this long (s) for the consuming hosts' subscribers before
+    /// the host's sources start (e.g. on the sensor host). 0 = no wait.
+    #[serde(default)]
+    pub wait_for_link_s: f64,
+}
+
+fn default_mode() -> String {
+    "peer".to_string()
+}
+
+/// Access control and tuning of the link between hosts.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LinkSettings {
+    /// usrpwd dictionary of the hosts' accounts; hosts that listen admit
+    /// only the `peers` accounts (ACL by user name, default deny).
+    /// Relative to the descriptor's directory. None: no access control.
+    pub dictionary_file: Option<PathBuf>,
+    /// The hosts' accounts (the `peers` role of deploy/SECURITY.md).
+    pub peers: Vec<String>,
+    /// Largest rate of clouds over the link (Hz); None: every frame.
+    pub cloud_rate_hz: Option<f64>,
 }
 
 fn default_heartbeat_ms() -> u64 {
@@ -89,6 +150,9 @@ pub struct ServiceEntry {
     /// the descriptor's directory.
     #[serde(default)]
     pub binary: Option<PathBuf>,
+    /// Host of a partitioned deployment that runs this instance.
+    #[serde(default)]
+    pub host: Option<String>,
     /// Restart policy of this instance (default: the descriptor's `[restart]`).
     #[serde(default)]
     pub restart_policy: Option<Policy>,

@@ -22,11 +22,15 @@ pub enum ServiceKind {
     Telemetry,
     /// Pose acquisition at start and after a loss (`spacepose-init`).
     Init,
+    /// The topics that cross hosts, over zenoh (`spacepose-bridge`); added
+    /// by `spacepose up --host` to each host's part of a partitioned
+    /// deployment, never written in a descriptor.
+    Bridge,
 }
 
 impl ServiceKind {
     /// Every kind.
-    pub const ALL: [ServiceKind; 7] = [
+    pub const ALL: [ServiceKind; 8] = [
         ServiceKind::LidarSim,
         ServiceKind::PcdReplay,
         ServiceKind::Ingest,
@@ -34,6 +38,7 @@ impl ServiceKind {
         ServiceKind::Filter,
         ServiceKind::Telemetry,
         ServiceKind::Init,
+        ServiceKind::Bridge,
     ];
 
     /// The descriptor spelling (`"lidar-sim"`, ...).
@@ -46,6 +51,7 @@ impl ServiceKind {
             ServiceKind::Filter => "filter",
             ServiceKind::Telemetry => "telemetry",
             ServiceKind::Init => "init",
+            ServiceKind::Bridge => "bridge",
         }
     }
 
@@ -69,7 +75,7 @@ impl ServiceKind {
     /// producer in the descriptor.
     pub fn required_inputs(self) -> &'static [Topic] {
         match self {
-            ServiceKind::LidarSim | ServiceKind::PcdReplay => &[],
+            ServiceKind::LidarSim | ServiceKind::PcdReplay | ServiceKind::Bridge => &[],
             ServiceKind::Ingest => &[Topic::RawCloud],
             // The first pose comes from the init service (or, the old
             // documented path, lidar-sim's `truth_init = true`).
@@ -90,6 +96,8 @@ impl ServiceKind {
             ServiceKind::Telemetry => &[Topic::Pose, Topic::FilterState, Topic::Truth],
             // Without tracker poses it acquires once and never hears of a loss.
             ServiceKind::Init => &[Topic::Pose],
+            // Its routes are in its config (`partition::bridge_outputs`).
+            ServiceKind::Bridge => &[],
         }
     }
 
@@ -102,9 +110,12 @@ impl ServiceKind {
             ServiceKind::Ingest => vec![Topic::Cloud],
             ServiceKind::Tracker => vec![Topic::Pose],
             ServiceKind::Filter => vec![Topic::FilterState],
-            // JSON on zenoh only (no inbound command route yet).
-            ServiceKind::Telemetry => vec![],
+            // JSON on zenoh; the ground's commands come in through its
+            // command bridge.
+            ServiceKind::Telemetry => vec![Topic::Command],
             ServiceKind::Init => vec![Topic::Acquisition],
+            // Its inbound routes (`partition::bridge_outputs`).
+            ServiceKind::Bridge => vec![],
         };
         if self == ServiceKind::LidarSim && truth_init {
             out.push(Topic::Acquisition);

@@ -66,9 +66,13 @@ pub fn start(plan: &Plan, watch: &mut HealthWatch, out: &mut dyn Write) -> Resul
     check_not_running(&prefix)?;
     let dir = run_dir(&prefix);
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    // NDT maps cached by an earlier run of this prefix may be of another target.
+    // NDT maps cached by an earlier run of this prefix may be of another
+    // target; filter snapshots are of another run (restarts keep both).
     for e in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
-        if e.path().extension().is_some_and(|x| x == "ndtmap") {
+        if e.path()
+            .extension()
+            .is_some_and(|x| x == "ndtmap" || x == "filterstate")
+        {
             let _ = std::fs::remove_file(e.path());
         }
     }

@@ -11,6 +11,7 @@ pub mod down;
 pub mod health;
 pub mod kind;
 pub mod launch;
+pub mod partition;
 pub mod plan;
 pub mod process;
 pub mod restart;

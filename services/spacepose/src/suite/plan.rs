@@ -86,7 +86,10 @@ pub fn truth_init(config: &toml::Table) -> bool {
 /// of telemetry (unless its config sets its own `zenoh` table), and the NDT
 /// map file of a tracker (unless it sets `map_file`): `map_dir/{name}.ndtmap`,
 /// built on the first start and loaded by every restart, so a restarted
-/// tracker is back within a fraction of a second instead of rebuilding it.
+/// tracker is back within a fraction of a second instead of rebuilding it;
+/// the state snapshot of a filter (`snapshot_file`, `{name}.filterstate`,
+/// from which a restarted filter resumes) and the statistics file of a
+/// bridge (`stats_file`, `{name}.stats.json`), in the same directory.
 pub fn deployment_config(
     kind: ServiceKind,
     config: &toml::Table,
@@ -101,6 +104,15 @@ pub fn deployment_config(
             "map_file".into(),
             toml::Value::String(path.display().to_string()),
         );
+    }
+    let file = |ext: &str| {
+        toml::Value::String(map_dir.join(format!("{name}.{ext}")).display().to_string())
+    };
+    if kind == ServiceKind::Filter && !config.contains_key("snapshot_file") {
+        config.insert("snapshot_file".into(), file("filterstate"));
+    }
+    if kind == ServiceKind::Bridge && !config.contains_key("stats_file") {
+        config.insert("stats_file".into(), file("stats.json"));
     }
     if kind == ServiceKind::Telemetry && !config.contains_key("zenoh") {
         let mut z = toml::Table::new();
@@ -125,6 +137,18 @@ pub fn plan(
         .ok();
     if descriptor.services.is_empty() {
         problems.push("no [[service]] entries".to_string());
+    }
+    if !descriptor.hosts.is_empty() {
+        let hosts: Vec<&str> = descriptor.hosts.iter().map(|h| h.name.as_str()).collect();
+        problems.push(format!(
+            "the descriptor is partitioned over hosts {}: start each host's part with              `spacepose up --host NAME`",
+            hosts.join(", ")
+        ));
+    } else if let Some(s) = descriptor.services.iter().find(|s| s.host.is_some()) {
+        problems.push(format!(
+            "service {:?} names a host, but the descriptor has no [[host]] tables",
+            s.name
+        ));
     }
     if !(descriptor.health_timeout_s.is_finite() && descriptor.health_timeout_s > 0.0) {
         problems.push(format!(
@@ -208,10 +232,16 @@ fn check_instance_names(descriptor: &Descriptor, problems: &mut Vec<String>) {
     }
 }
 
-fn check_topics(descriptor: &Descriptor, problems: &mut Vec<String>) {
+/// Every required input has a producer among the descriptor's services (a
+/// host part's bridge produces its inbound routes).
+pub(super) fn check_topics(descriptor: &Descriptor, problems: &mut Vec<String>) {
     let mut producers: HashMap<Topic, Vec<&str>> = HashMap::new();
     for s in &descriptor.services {
-        for t in s.kind.outputs(truth_init(&s.config)) {
+        let outputs = match s.kind {
+            ServiceKind::Bridge => super::partition::bridge_outputs(&s.config),
+            kind => kind.outputs(truth_init(&s.config)),
+        };
+        for t in outputs {
             producers.entry(t).or_default().push(&s.name);
         }
     }

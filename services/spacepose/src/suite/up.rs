@@ -22,6 +22,8 @@ pub struct Overrides {
     pub listen: Option<Vec<String>>,
     /// zenoh endpoints to connect to (replace the descriptor's).
     pub connect: Option<Vec<String>>,
+    /// The host whose part of a partitioned descriptor to start.
+    pub host: Option<String>,
 }
 
 impl Overrides {
@@ -42,6 +44,11 @@ impl Overrides {
 /// Loads, overrides and validates a descriptor file.
 pub fn load_plan(path: &Path, overrides: &Overrides) -> Result<(Descriptor, Plan)> {
     let mut d = Descriptor::load(path)?;
+    if let Some(host) = &overrides.host {
+        let base = path.parent().unwrap_or(Path::new("."));
+        d = super::partition::host_part(&d, host, base)
+            .with_context(|| format!("host {host:?} of {} was not started", path.display()))?;
+    }
     overrides.apply(&mut d);
     let p = plan_descriptor(&d, path)?;
     Ok((d, p))
@@ -108,6 +115,9 @@ fn override_args(overrides: &Overrides) -> Vec<String> {
     }
     for c in overrides.connect.iter().flatten() {
         args.extend(["--connect".to_string(), c.clone()]);
+    }
+    if let Some(h) = &overrides.host {
+        args.extend(["--host".to_string(), h.clone()]);
     }
     args
 }
