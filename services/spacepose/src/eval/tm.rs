@@ -84,6 +84,10 @@ pub struct TmOptions {
     /// f_MAX (m²) for the accepted flag.
     #[arg(long)]
     pub f_max: Option<f64>,
+    /// f_CONV as seed 002 §4.5 (mean squared distance over every point, no
+    /// cap) instead of the truncated one.
+    #[arg(long)]
+    pub paper_f_conv: bool,
 }
 
 /// `spacepose eval tm`.
@@ -125,6 +129,7 @@ impl TmOptions {
                 keep: self.coarse_keep,
             }),
             max_correlation_points: self.max_corr_points,
+            robust_f_conv: !self.paper_f_conv,
             ..d
         }
     }
