@@ -38,6 +38,18 @@ pub fn decode(
     if labels[i_max] <= 0.0 {
         return Err(CnnError::BadLabels("all weights are zero"));
     }
+    Ok(decode_around(classes, labels, i_max, delta_beta_rad))
+}
+
+/// Algorithm 1 around class `i_max` instead of the most probable one (a
+/// second mode of the label vector); `labels` must already be checked and
+/// `i_max < m`.
+pub(crate) fn decode_around(
+    classes: &ClassTable,
+    labels: &[f32],
+    i_max: usize,
+    delta_beta_rad: f64,
+) -> Rotation3<f64> {
     let r_max = classes.rotations()[i_max];
     let syms = classes.symmetries();
     let mut sum = Matrix3::zeros();
@@ -57,7 +69,35 @@ pub fn decode(
             sum += r_jk.matrix() * f64::from(l_j);
         }
     }
-    Ok(project_to_so3(&sum))
+    project_to_so3(&sum)
+}
+
+/// The `k` most probable modes of a checked label vector: class indices in
+/// decreasing probability, each at least `delta_beta_rad` (d_sym, Eq. 14)
+/// from the ones before, so that [`decode_around`] on each gives distinct
+/// attitude hypotheses (the first is Algorithm 1's `i_max`).
+pub(crate) fn modes(
+    classes: &ClassTable,
+    labels: &[f32],
+    k: usize,
+    delta_beta_rad: f64,
+) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..labels.len()).collect();
+    order.sort_by(|&a, &b| labels[b].total_cmp(&labels[a]));
+    let rotations = classes.rotations();
+    let mut chosen: Vec<usize> = Vec::with_capacity(k);
+    for i in order {
+        if chosen.len() == k || labels[i] <= 0.0 {
+            break;
+        }
+        let far = chosen.iter().all(|&c| {
+            so3::distance_sym(&rotations[c], &rotations[i], classes.symmetries()) >= delta_beta_rad
+        });
+        if far {
+            chosen.push(i);
+        }
+    }
+    chosen
 }
 
 /// Orthogonal projection on SO(3), `U Vᵀ` (Eq. 10), with the sign of the last

@@ -99,3 +99,39 @@ fn projection_gives_a_rotation() {
     assert!((r.matrix().determinant() - 1.0).abs() < 1e-9);
     assert!((r.matrix().transpose() * r.matrix() - Matrix3::identity()).norm() < 1e-9);
 }
+
+#[test]
+fn modes_start_at_the_argmax_and_stay_delta_beta_apart() {
+    let deos = spacepose_target::Target::builtin("deos").unwrap();
+    let classes = ClassTable::for_target(&deos, 20.0).unwrap();
+    let r = crate::classes::euler_zyx(0.4, 0.2, 0.3);
+    let mut labels = crate::labels::soft_labels(&classes, &r);
+    // A second, weaker bump far from the first.
+    let far = crate::labels::soft_labels(&classes, &crate::classes::euler_zyx(2.5, -0.8, 1.0));
+    for (l, f) in labels.iter_mut().zip(&far) {
+        *l = 0.7 * *l + 0.3 * f;
+    }
+    let beta = 50f64.to_radians();
+    let m = modes(&classes, &labels, 3, beta);
+    assert_eq!(m.len(), 3);
+    let argmax = (0..labels.len())
+        .max_by(|&a, &b| labels[a].total_cmp(&labels[b]))
+        .unwrap();
+    assert_eq!(m[0], argmax);
+    let rot = classes.rotations();
+    for i in 0..m.len() {
+        for j in 0..i {
+            let d = so3::distance_sym(&rot[m[i]], &rot[m[j]], classes.symmetries());
+            assert!(
+                d >= beta,
+                "modes {i} and {j} are {:.1} deg apart",
+                d.to_degrees()
+            );
+        }
+    }
+    // The second mode decodes near the second bump.
+    let second = decode_around(&classes, &labels, m[1], beta);
+    let truth = crate::classes::euler_zyx(2.5, -0.8, 1.0);
+    let err = so3::distance_sym(&second, &truth, classes.symmetries()).to_degrees();
+    assert!(err < 10.0, "second mode {err:.1} deg from its bump");
+}

@@ -22,14 +22,16 @@ use spacepose_inference::{Engine, ModelShape, PoseNet};
 use spacepose_target::Target;
 
 use crate::classes::{ClassTable, DEFAULT_ROLL_STEP_DEG};
-use crate::decode::{DEFAULT_DELTA_BETA_DEG, decode};
+use crate::decode::{DEFAULT_DELTA_BETA_DEG, decode, decode_around, modes};
 use crate::error::CnnError;
 use crate::model_meta::{ModelMeta, model_onnx_path};
 use crate::preprocess::{PreprocessConfig, preprocess};
-use crate::refinement::{RefinementConfig, Refiner, ms};
+use crate::refinement::{Refined, RefinementConfig, Refiner, ms};
 
 /// Fewer finite points than this is an error, never an estimate.
 pub const MIN_POINTS: usize = 20;
+/// Default [`EstimatorConfig::hypotheses`].
+pub const DEFAULT_HYPOTHESES: usize = 3;
 
 /// Estimator settings beyond what `model.json` fixes.
 #[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
@@ -41,6 +43,13 @@ pub struct EstimatorConfig {
     pub delta_beta_deg: f64,
     /// Minimum finite points (at least [`MIN_POINTS`]).
     pub min_points: usize,
+    /// Attitude hypotheses refined at most: the modes of the network's
+    /// output (classes at least Δβ apart, in decreasing probability, each
+    /// decoded by Algorithm 1 around it) are refined in turn until one
+    /// passes the f_CONV check; none passing, the lowest f_CONV is kept.
+    /// 1 = the paper (only Γ_sym's estimate). A frame the first hypothesis
+    /// passes costs one refinement whatever this is.
+    pub hypotheses: usize,
     /// Refinement and failure check.
     pub refinement: RefinementConfig,
 }
@@ -51,6 +60,7 @@ impl Default for EstimatorConfig {
             roll_step_deg: DEFAULT_ROLL_STEP_DEG,
             delta_beta_deg: DEFAULT_DELTA_BETA_DEG,
             min_points: MIN_POINTS,
+            hypotheses: DEFAULT_HYPOTHESES,
             refinement: RefinementConfig::default(),
         }
     }
@@ -88,7 +98,11 @@ pub struct CnnEstimate {
     pub points: usize,
     /// Points inside the ROI.
     pub points_in_roi: usize,
-    /// NDT iterations (all stages).
+    /// Which hypothesis the reported pose comes from (0 = Γ_sym's).
+    pub hypothesis: usize,
+    /// Hypotheses refined.
+    pub hypotheses_refined: usize,
+    /// NDT iterations (all stages) of the reported hypothesis.
     pub ndt_iterations: usize,
     /// The final NDT stage converged.
     pub ndt_converged: bool,
@@ -98,6 +112,17 @@ pub struct CnnEstimate {
     pub time_ms: Timings,
     /// Of the refinement: the f_CONV ICP (ms).
     pub fconv_ms: f64,
+}
+
+/// The refinement of the attitude hypotheses of one frame.
+struct Hypotheses {
+    /// The hypothesis index and refinement with the lowest f_CONV (the
+    /// first accepted one).
+    best: Option<(usize, Refined)>,
+    /// Hypotheses refined.
+    tried: usize,
+    /// The first refinement error, if any.
+    error: Option<String>,
 }
 
 /// A loaded network with its class table, preprocessing and refinement
@@ -156,6 +181,12 @@ impl CnnEstimator {
                 value: config.min_points as f64,
             });
         }
+        if config.hypotheses == 0 {
+            return Err(CnnError::InvalidParameter {
+                name: "hypotheses",
+                value: 0.0,
+            });
+        }
         if !(config.delta_beta_deg.is_finite() && config.delta_beta_deg > 0.0) {
             return Err(CnnError::InvalidParameter {
                 name: "delta_beta_deg",
@@ -211,11 +242,8 @@ impl CnnEstimator {
             .lock()
             .unwrap_or_else(PoisonError::into_inner)
             .infer(&image.pixels)?;
-        let rotation = decode(
-            &self.classes,
-            &out.probs,
-            self.config.delta_beta_deg.to_radians(),
-        )?;
+        let delta_beta = self.config.delta_beta_deg.to_radians();
+        let rotation = decode(&self.classes, &out.probs, delta_beta)?;
         // §III.B: the position is the ROI centre plus the predicted offset.
         let offset = nalgebra::Vector3::from(out.pos_offset_m.map(f64::from));
         let raw = Pose {
@@ -232,7 +260,7 @@ impl CnnEstimator {
         let inference_ms = ms(t);
 
         let t = Instant::now();
-        let refined = self.refiner.refine(&finite, &raw);
+        let refined = self.refine_hypotheses(&finite, &raw, &out.probs, delta_beta);
         let refinement_ms = ms(t);
         let mut estimate = CnnEstimate {
             t_sensor_target_raw: raw,
@@ -243,6 +271,8 @@ impl CnnEstimator {
             top_probability,
             points: finite.len(),
             points_in_roi: image.points_in_roi,
+            hypothesis: 0,
+            hypotheses_refined: refined.tried,
             ndt_iterations: 0,
             ndt_converged: false,
             refinement_error: None,
@@ -254,18 +284,72 @@ impl CnnEstimator {
             },
             fconv_ms: 0.0,
         };
-        match refined {
-            Ok(r) => {
+        match refined.best {
+            Some((h, r)) => {
                 estimate.t_sensor_target = r.t_sensor_target;
                 estimate.f_conv_m2 = r.f_conv_m2;
                 estimate.accepted = self.refiner.accepts(r.f_conv_m2);
+                estimate.hypothesis = h;
                 estimate.ndt_iterations = r.ndt_iterations;
                 estimate.ndt_converged = r.ndt_converged;
                 estimate.fconv_ms = r.fconv_ms;
             }
-            Err(e) => estimate.refinement_error = Some(e.to_string()),
+            None => estimate.refinement_error = refined.error,
         }
         Ok(estimate)
+    }
+
+    /// Refines Γ_sym's pose, then the other modes of `probs` (same position)
+    /// until one passes the f_CONV check; keeps the lowest f_CONV.
+    fn refine_hypotheses(
+        &self,
+        cloud: &[Point],
+        raw: &Pose,
+        probs: &[f32],
+        delta_beta: f64,
+    ) -> Hypotheses {
+        let mut result = Hypotheses {
+            best: None,
+            tried: 0,
+            error: None,
+        };
+        let modes = if self.config.hypotheses > 1 {
+            modes(&self.classes, probs, self.config.hypotheses, delta_beta)
+        } else {
+            Vec::new()
+        };
+        let rotations = std::iter::once(raw.rotation).chain(
+            modes
+                .into_iter()
+                .skip(1)
+                .map(|i| decode_around(&self.classes, probs, i, delta_beta)),
+        );
+        for (h, rotation) in rotations.enumerate() {
+            result.tried += 1;
+            let pose = Pose {
+                rotation,
+                translation: raw.translation,
+            };
+            match self.refiner.refine(cloud, &pose) {
+                Ok(r) => {
+                    let accepted = self.refiner.accepts(r.f_conv_m2);
+                    if result
+                        .best
+                        .as_ref()
+                        .is_none_or(|(_, b)| r.f_conv_m2 < b.f_conv_m2)
+                    {
+                        result.best = Some((h, r));
+                    }
+                    if accepted {
+                        break;
+                    }
+                }
+                Err(e) => {
+                    result.error.get_or_insert(e.to_string());
+                }
+            }
+        }
+        result
     }
 
     /// The class table.
