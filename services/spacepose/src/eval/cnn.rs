@@ -71,6 +71,9 @@ pub struct EvalCnnArgs {
     /// "none" for the paper's single stage). Default: the estimator's.
     #[arg(long)]
     pub ndt_stages: Option<String>,
+    /// Attitude hypotheses refined at most (1 = the paper). Default: the estimator's.
+    #[arg(long)]
+    pub hypotheses: Option<usize>,
     /// Points kept for the refinement (0 = all). Default: the estimator's.
     #[arg(long)]
     pub max_points: Option<usize>,
@@ -94,6 +97,10 @@ pub struct CnnFrame {
     pub range_m: f64,
     /// Points in the frame.
     pub points: usize,
+    /// Angular rate of the target (deg/s): motion blur.
+    pub rate_deg_s: f64,
+    /// Time spanned by the points (s).
+    pub scan_s: f64,
     /// Attitude error of the network's pose (deg, d_sym).
     pub raw_err_deg: f64,
     /// Position error of the network's pose (cm).
@@ -112,6 +119,10 @@ pub struct CnnFrame {
     pub accepted: bool,
     /// Probability of the top class.
     pub top_probability: f32,
+    /// Hypothesis of the reported pose (0 = Γ_sym's).
+    pub hypothesis: usize,
+    /// Hypotheses refined.
+    pub hypotheses_refined: usize,
     /// Run time split (ms).
     pub time_ms: spacepose_cnn::Timings,
     /// Of the refinement: the f_CONV ICP (ms).
@@ -263,6 +274,10 @@ pub struct CnnReport {
     pub by_range: Vec<RangeBin>,
     /// Estimator errors (counted as failures).
     pub errors: usize,
+    /// Frames whose reported pose comes from another hypothesis than Γ_sym's.
+    pub other_hypothesis: usize,
+    /// Frames where more than one hypothesis was refined.
+    pub several_hypotheses: usize,
     /// Mean points per frame.
     pub mean_points: f64,
     /// Estimator settings.
@@ -290,6 +305,16 @@ fn errors(estimate: &Pose, truth: &Pose, syms: &[nalgebra::Rotation3<f64>]) -> (
     (deg, cm)
 }
 
+/// Time spanned by the points' timestamps (s).
+fn scan_duration(points: &[spacepose_geometry::Point]) -> f64 {
+    let (lo, hi) = points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p.t), hi.max(p.t))
+        });
+    if hi >= lo { hi - lo } else { 0.0 }
+}
+
 fn score(estimator: &CnnEstimator, index: u64, f: &GeneratedFrame) -> CnnFrame {
     let truth = &f.truth.t_sensor_target;
     let syms = estimator.classes().symmetries();
@@ -297,6 +322,8 @@ fn score(estimator: &CnnEstimator, index: u64, f: &GeneratedFrame) -> CnnFrame {
         frame: index,
         range_m: truth.translation.norm(),
         points: f.points.len(),
+        rate_deg_s: f.truth.w_target.norm().to_degrees(),
+        scan_s: scan_duration(&f.points),
         raw_err_deg: f64::NAN,
         raw_err_cm: f64::NAN,
         err_deg: f64::NAN,
@@ -306,6 +333,8 @@ fn score(estimator: &CnnEstimator, index: u64, f: &GeneratedFrame) -> CnnFrame {
         f_conv_m2: f64::INFINITY,
         accepted: false,
         top_probability: 0.0,
+        hypothesis: 0,
+        hypotheses_refined: 0,
         time_ms: spacepose_cnn::Timings::default(),
         fconv_ms: f64::NAN,
         error: None,
@@ -321,6 +350,8 @@ fn score(estimator: &CnnEstimator, index: u64, f: &GeneratedFrame) -> CnnFrame {
             row.f_conv_m2 = e.f_conv_m2;
             row.accepted = e.accepted;
             row.top_probability = e.top_probability;
+            row.hypothesis = e.hypothesis;
+            row.hypotheses_refined = e.hypotheses_refined;
             row.time_ms = e.time_ms;
             row.fconv_ms = e.fconv_ms;
             row.error = e.refinement_error;
@@ -346,6 +377,9 @@ pub fn evaluate(args: &EvalCnnArgs) -> Result<CnnReport> {
     let mut config = EstimatorConfig::default();
     if let Some(f_max) = args.f_max {
         config.refinement.f_max_m2 = f_max;
+    }
+    if let Some(h) = args.hypotheses {
+        config.hypotheses = h;
     }
     if let Some(max_points) = args.max_points {
         config.refinement.max_points = max_points;
@@ -478,6 +512,8 @@ fn report(
         },
         by_range,
         errors: frames.iter().filter(|r| r.error.is_some()).count(),
+        other_hypothesis: frames.iter().filter(|r| r.hypothesis > 0).count(),
+        several_hypotheses: frames.iter().filter(|r| r.hypotheses_refined > 1).count(),
         mean_points: frames.iter().map(|r| r.points as f64).sum::<f64>() / n,
         config,
         frames,
@@ -488,14 +524,18 @@ fn report(
 pub fn print(report: &CnnReport, frames: bool) {
     println!(
         "CNN pose estimation, {} held-out frames (seed {}), target {}, model {}, engine {} (one thread); \
-         mean {:.0} points per frame; {} estimator errors",
+         mean {:.0} points per frame; {} estimator errors; {} frames refined several \
+         hypotheses, {} reported a hypothesis other than Γ_sym's (max {})",
         report.count,
         report.seed,
         report.target,
         report.model,
         report.engine,
         report.mean_points,
-        report.errors
+        report.errors,
+        report.several_hypotheses,
+        report.other_hypothesis,
+        report.config.hypotheses
     );
     let pct = |v: f64| num(100.0 * v, 1);
     let ms = |m: MeanStd, d| format!("{} ± {}", num(m.mean, d), num(m.std, d));
