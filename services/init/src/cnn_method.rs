@@ -129,7 +129,12 @@ impl PoseAcquirer for CnnMethod {
         let t = e.time_ms;
         let refinement = match &e.refinement_error {
             Some(err) => format!("refinement failed: {err}"),
-            None => format!("{} NDT iterations", e.ndt_iterations),
+            None => format!(
+                "hypothesis {} of {} refined, {} NDT iterations",
+                e.hypothesis + 1,
+                e.hypotheses_refined,
+                e.ndt_iterations
+            ),
         };
         Ok(MethodOutput {
             t_sensor_target: e.t_sensor_target,
