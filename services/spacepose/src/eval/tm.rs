@@ -84,10 +84,10 @@ pub struct TmOptions {
     /// f_MAX (m²) for the accepted flag.
     #[arg(long)]
     pub f_max: Option<f64>,
-    /// f_CONV as seed 002 §4.5 (mean squared distance over every point, no
-    /// cap) instead of the truncated one.
+    /// Truncated f_CONV (squared distances capped at the final ICP's
+    /// correspondence distance²) instead of seed 002 §4.5's plain mean.
     #[arg(long)]
-    pub paper_f_conv: bool,
+    pub robust_f_conv: bool,
 }
 
 /// `spacepose eval tm`.
@@ -129,7 +129,7 @@ impl TmOptions {
                 keep: self.coarse_keep,
             }),
             max_correlation_points: self.max_corr_points,
-            robust_f_conv: !self.paper_f_conv,
+            robust_f_conv: self.robust_f_conv,
             ..d
         }
     }
