@@ -11,7 +11,7 @@ use spacepose_geometry::Point;
 use spacepose_inference::{Engine, find_ort_library};
 use spacepose_messages::AcquisitionMethod;
 use spacepose_target::Target;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// Which engine runs the network.
@@ -29,8 +29,9 @@ pub enum CnnEngine {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct CnnMethodConfig {
-    /// Directory holding `model.onnx` and `model.json` (relative paths are
-    /// relative to the service's working directory).
+    /// Directory holding `model.onnx` and `model.json`. A relative path is
+    /// looked up in the service's working directory, then in the source
+    /// tree's root (where `services/cnn/models/<target>` is committed).
     pub model_dir: PathBuf,
     /// The inference engine.
     pub engine: CnnEngine,
@@ -87,6 +88,22 @@ impl CnnMethodConfig {
     }
 }
 
+/// `dir` itself when it exists or is absolute, else `dir` under the source
+/// tree's root when it exists there, else `dir` (whose error names it).
+fn resolve_model_dir(dir: &Path) -> PathBuf {
+    if dir.is_absolute() || dir.exists() {
+        return dir.to_path_buf();
+    }
+    let in_tree = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(dir);
+    if in_tree.exists() {
+        in_tree
+    } else {
+        dir.to_path_buf()
+    }
+}
+
 fn build_error(reason: String) -> InitError {
     InitError::Build {
         method: AcquisitionMethod::Cnn.as_str(),
@@ -106,9 +123,9 @@ impl CnnMethod {
         config.validate()?;
         let mut estimator = config.estimator.clone();
         estimator.refinement.f_max_m2 = config.f_max_m2;
-        let estimator =
-            CnnEstimator::load_with(&config.model_dir, config.engine()?, target, estimator)
-                .map_err(|e| build_error(e.to_string()))?;
+        let model_dir = resolve_model_dir(&config.model_dir);
+        let estimator = CnnEstimator::load_with(&model_dir, config.engine()?, target, estimator)
+            .map_err(|e| build_error(e.to_string()))?;
         Ok(Self { estimator })
     }
 }
