@@ -26,10 +26,10 @@ const LOOK_FRAMES: u64 = 3;
 const RETURN: u64 = LOOK_FIRST + LOOK_FRAMES;
 const RATE_HZ: f64 = 2.0;
 
-/// deploy/examples/demo-init.toml (the demo without truth) with lidar-sim's
+/// deploy/demo.toml (the demo without truth: CNN, then template matching) with lidar-sim's
 /// frames and rate replaced.
 fn descriptor(dir: &std::path::Path) -> std::path::PathBuf {
-    let text = std::fs::read_to_string(repo_root().join("deploy/examples/demo-init.toml")).unwrap();
+    let text = std::fs::read_to_string(repo_root().join("deploy/demo.toml")).unwrap();
     let text = replace_key(&text, "frames", &FRAMES.to_string());
     let text = replace_key(&text, "rate_hz", &format!("{RATE_HZ:.3}"));
     let path = dir.join("demo-init.toml");
@@ -42,7 +42,6 @@ fn status(p: &PoseEstimate) -> WireStatus {
 }
 
 #[test]
-#[ignore = "fails: the template matcher does not accept deos/Mid-40 frames yet (f_CONV 0.04-0.05 m² > f_MAX, attitudes 90-170° off; services/init/tests/template_chain.rs), so nothing is acquired"]
 fn the_suite_acquires_at_start_detects_the_loss_and_reacquires() {
     require_suite();
     let dir = scratch_dir("reacquire");

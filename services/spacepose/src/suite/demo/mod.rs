@@ -84,6 +84,21 @@ fn demo_descriptor(opts: &DemoOptions) -> Result<Descriptor> {
     Ok(d)
 }
 
+/// The symmetry group of the sensor's target, for scoring with `d_sym`:
+/// a built-in target's declared group; none for a mesh file (which declares
+/// none) or an unknown name (lidar-sim's own `--check` reports that).
+fn target_symmetries(d: &Descriptor) -> Vec<nalgebra::Rotation3<f64>> {
+    let name = d
+        .instances_of(ServiceKind::LidarSim)
+        .next()
+        .and_then(|s| s.config.get("target"))
+        .and_then(toml::Value::as_str)
+        .unwrap_or("deos");
+    spacepose_target::Target::builtin(name)
+        .map(|t| t.symmetries().to_vec())
+        .unwrap_or_default()
+}
+
 struct Ports {
     poses: Subscriber<PoseEstimate>,
     truth: Subscriber<TruthMsg>,
@@ -162,7 +177,8 @@ pub fn run(opts: &DemoOptions, out: &mut dyn Write) -> Result<Summary> {
             at_ns: 0,
         })
         .collect();
-    let followed = follow(opts, &bus, &ports, &mut sup, &mut injections, out);
+    let scorer = Scorer::with_symmetries(target_symmetries(&d));
+    let followed = follow(opts, &bus, &ports, &mut sup, &mut injections, scorer, out);
     // Frozen processes cannot stop: thaw them first.
     for i in injections.iter().filter(|i| i.spec.action == Action::Stop) {
         sup.suite
@@ -216,13 +232,13 @@ fn follow(
     ports: &Ports,
     sup: &mut Supervisor,
     injections: &mut [Injection],
+    mut scorer: Scorer,
     out: &mut dyn Write,
 ) -> Result<Scorer> {
     let mut waiter = bus.waitset()?;
     waiter.attach(&ports.poses)?;
     waiter.attach(&ports.truth)?;
     waiter.attach(&ports.raw)?;
-    let mut scorer = Scorer::default();
     let start = Instant::now();
     let mut last_truth = Instant::now();
     let mut newest_raw: Option<u64> = None;
