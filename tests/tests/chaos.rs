@@ -126,6 +126,10 @@ fn killing_each_other_service_in_turn_the_suite_recovers() {
             "kill:filter@10",
             "--chaos",
             "kill:telemetry@13",
+            // Early too: a new init service loads the CNN and builds the
+            // template matcher's models before its first heartbeat.
+            "--chaos",
+            "kill:init@4",
         ],
     );
     println!("{}", figures(&s));
