@@ -27,6 +27,7 @@ use crate::error::CnnError;
 use crate::model_meta::{ModelMeta, model_onnx_path};
 use crate::preprocess::{PreprocessConfig, preprocess};
 use crate::refinement::{Refined, RefinementConfig, Refiner, ms};
+use crate::twins::{TwinCheckConfig, TwinOutcome, check_twins};
 
 /// Fewer finite points than this is an error, never an estimate.
 pub const MIN_POINTS: usize = 20;
@@ -52,6 +53,8 @@ pub struct EstimatorConfig {
     pub hypotheses: usize,
     /// Refinement and failure check.
     pub refinement: RefinementConfig,
+    /// The twin check after the refinement ([`crate::twins`]).
+    pub twins: TwinCheckConfig,
 }
 
 impl Default for EstimatorConfig {
@@ -62,6 +65,7 @@ impl Default for EstimatorConfig {
             min_points: MIN_POINTS,
             hypotheses: DEFAULT_HYPOTHESES,
             refinement: RefinementConfig::default(),
+            twins: TwinCheckConfig::default(),
         }
     }
 }
@@ -73,7 +77,7 @@ pub struct Timings {
     pub preprocess: f64,
     /// Network and Γ_sym decoding.
     pub inference: f64,
-    /// Voxel filter, NDT and the f_CONV ICP.
+    /// Voxel filter, NDT, the f_CONV ICP and the twin check.
     pub refinement: f64,
     /// Everything.
     pub total: f64,
@@ -90,6 +94,9 @@ pub struct CnnEstimate {
     pub f_conv_m2: f64,
     /// `f_CONV <= f_MAX`: the pose may be used.
     pub accepted: bool,
+    /// The twin check of the refined pose (default when the refinement
+    /// failed).
+    pub twins: TwinOutcome,
     /// Class of largest probability.
     pub top_class: usize,
     /// Its probability.
@@ -260,13 +267,20 @@ impl CnnEstimator {
         let inference_ms = ms(t);
 
         let t = Instant::now();
-        let refined = self.refine_hypotheses(&finite, &raw, &out.probs, delta_beta);
+        let mut refined = self.refine_hypotheses(&finite, &raw, &out.probs, delta_beta);
+        let mut twins = TwinOutcome::default();
+        if let Some((h, r)) = refined.best.take() {
+            let (r, outcome) = check_twins(&self.refiner, &finite, r, &self.config.twins);
+            refined.best = Some((h, r));
+            twins = outcome;
+        }
         let refinement_ms = ms(t);
         let mut estimate = CnnEstimate {
             t_sensor_target_raw: raw,
             t_sensor_target: raw,
             f_conv_m2: f64::INFINITY,
             accepted: false,
+            twins,
             top_class,
             top_probability,
             points: finite.len(),

@@ -28,6 +28,7 @@ pub mod model_meta;
 pub mod npy;
 pub mod preprocess;
 pub mod refinement;
+pub mod twins;
 
 pub use classes::{ClassTable, DEFAULT_ROLL_STEP_DEG};
 pub use dataset::{
@@ -39,3 +40,4 @@ pub use estimator::{CnnEstimate, CnnEstimator, EstimatorConfig, Timings};
 pub use labels::soft_labels;
 pub use preprocess::{DEFAULT_IMAGE_SIZE, DepthImage, PreprocessConfig, preprocess, roi_side_for};
 pub use refinement::{RefinementConfig, Refiner};
+pub use twins::{TwinCheckConfig, TwinOutcome};

@@ -147,10 +147,15 @@ impl PoseAcquirer for CnnMethod {
         let refinement = match &e.refinement_error {
             Some(err) => format!("refinement failed: {err}"),
             None => format!(
-                "hypothesis {} of {} refined, {} NDT iterations",
+                "hypothesis {} of {} refined, {} NDT iterations, {:.0}% of the points explained{}",
                 e.hypothesis + 1,
                 e.hypotheses_refined,
-                e.ndt_iterations
+                e.ndt_iterations,
+                100.0 * e.twins.explained,
+                match e.twins.twin {
+                    Some(i) => format!(", replaced by its twin {i}"),
+                    None => String::new(),
+                }
             ),
         };
         Ok(MethodOutput {

@@ -8,6 +8,7 @@
 #![forbid(unsafe_code)]
 
 pub mod builtin;
+pub mod consistency;
 mod error;
 mod loaders;
 pub mod material;
@@ -16,6 +17,7 @@ pub mod sampling;
 mod shapes;
 mod target;
 
+pub use consistency::{RangeMargin, RayConsistency, ray_consistency};
 pub use error::TargetError;
 pub use material::{Material, MaterialClass, MaterialId};
 pub use mesh::{Mesh, RayHit};

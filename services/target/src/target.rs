@@ -20,6 +20,7 @@ pub struct Target {
     mesh: Mesh,
     materials: Vec<Material>,
     symmetries: Vec<Rotation3<f64>>,
+    twins: Vec<Rotation3<f64>>,
     bounding_radius: f64,
 }
 
@@ -73,8 +74,25 @@ impl Target {
             mesh,
             materials,
             symmetries,
+            twins: Vec::new(),
             bounding_radius,
         })
+    }
+
+    /// This target with its near-symmetric twins declared (see
+    /// [`Target::twins`]). Errors on a non-finite rotation.
+    pub fn with_twins(mut self, twins: Vec<Rotation3<f64>>) -> Result<Target, TargetError> {
+        if twins
+            .iter()
+            .any(|s| s.matrix().iter().any(|c| !c.is_finite()))
+        {
+            return Err(TargetError::InvalidTarget {
+                name: self.name,
+                message: "non-finite twin rotation".to_owned(),
+            });
+        }
+        self.twins = twins;
+        Ok(self)
     }
 
     /// A built-in target by name (see [`Target::BUILTIN`]): `"envisat"` (seed 002 §3.1) or
@@ -123,7 +141,7 @@ impl Target {
             return Ok(self);
         }
         let mesh = self.mesh.scaled(scale)?;
-        Target::new(&self.name, mesh, self.materials, self.symmetries)
+        Target::new(&self.name, mesh, self.materials, self.symmetries)?.with_twins(self.twins)
     }
 
     /// Name of the target ("envisat", "deos", or the file stem of a loaded mesh).
@@ -145,6 +163,16 @@ impl Target {
     /// attitude `Q` is equivalent to `Q S_k`). Always starts with the identity.
     pub fn symmetries(&self) -> &[Rotation3<f64>] {
         &self.symmetries
+    }
+
+    /// Near-symmetric twins: rotations `F`, not symmetries, that map most
+    /// of the surface onto itself, so that the poses `R` and `R F` (same
+    /// translation) fit a partial view equally well unless it shows the
+    /// small features that tell them apart. One per class of the symmetry
+    /// group (`F` and `F S_k` are the same twin). An acquisition checks
+    /// them (`spacepose_target::consistency`). Empty for loaded meshes.
+    pub fn twins(&self) -> &[Rotation3<f64>] {
+        &self.twins
     }
 
     /// Largest distance of a vertex from the body origin (m).

@@ -117,6 +117,8 @@ pub struct CnnFrame {
     pub f_conv_m2: f64,
     /// f_CONV ≤ f_MAX.
     pub accepted: bool,
+    /// The twin check.
+    pub twins: spacepose_cnn::TwinOutcome,
     /// Probability of the top class.
     pub top_probability: f32,
     /// Hypothesis of the reported pose (0 = Γ_sym's).
@@ -278,6 +280,10 @@ pub struct CnnReport {
     pub other_hypothesis: usize,
     /// Frames where more than one hypothesis was refined.
     pub several_hypotheses: usize,
+    /// Frames where the twin check refined a twin.
+    pub twins_refined: usize,
+    /// Frames whose reported pose is a twin's refinement.
+    pub twin_used: usize,
     /// Mean points per frame.
     pub mean_points: f64,
     /// Estimator settings.
@@ -332,6 +338,7 @@ fn score(estimator: &CnnEstimator, index: u64, f: &GeneratedFrame) -> CnnFrame {
         success_refined: false,
         f_conv_m2: f64::INFINITY,
         accepted: false,
+        twins: spacepose_cnn::TwinOutcome::default(),
         top_probability: 0.0,
         hypothesis: 0,
         hypotheses_refined: 0,
@@ -349,6 +356,7 @@ fn score(estimator: &CnnEstimator, index: u64, f: &GeneratedFrame) -> CnnFrame {
             }
             row.f_conv_m2 = e.f_conv_m2;
             row.accepted = e.accepted;
+            row.twins = e.twins;
             row.top_probability = e.top_probability;
             row.hypothesis = e.hypothesis;
             row.hypotheses_refined = e.hypotheses_refined;
@@ -514,6 +522,8 @@ fn report(
         errors: frames.iter().filter(|r| r.error.is_some()).count(),
         other_hypothesis: frames.iter().filter(|r| r.hypothesis > 0).count(),
         several_hypotheses: frames.iter().filter(|r| r.hypotheses_refined > 1).count(),
+        twins_refined: frames.iter().filter(|r| r.twins.twins_refined > 0).count(),
+        twin_used: frames.iter().filter(|r| r.twins.twin.is_some()).count(),
         mean_points: frames.iter().map(|r| r.points as f64).sum::<f64>() / n,
         config,
         frames,
@@ -525,7 +535,8 @@ pub fn print(report: &CnnReport, frames: bool) {
     println!(
         "CNN pose estimation, {} held-out frames (seed {}), target {}, model {}, engine {} (one thread); \
          mean {:.0} points per frame; {} estimator errors; {} frames refined several \
-         hypotheses, {} reported a hypothesis other than Γ_sym's (max {})",
+         hypotheses, {} reported a hypothesis other than Γ_sym's (max {}); twin check: \
+         {} frames refined a twin, {} reported it",
         report.count,
         report.seed,
         report.target,
@@ -535,7 +546,9 @@ pub fn print(report: &CnnReport, frames: bool) {
         report.errors,
         report.several_hypotheses,
         report.other_hypothesis,
-        report.config.hypotheses
+        report.config.hypotheses,
+        report.twins_refined,
+        report.twin_used
     );
     let pct = |v: f64| num(100.0 * v, 1);
     let ms = |m: MeanStd, d| format!("{} ± {}", num(m.mean, d), num(m.std, d));
@@ -603,7 +616,8 @@ pub fn print(report: &CnnReport, frames: bool) {
     print!("\n{}", bins.render());
     if frames {
         let mut all = Table::new(&[
-            "frame", "range", "points", "raw deg", "raw cm", "deg", "cm", "f_conv", "ok", "ms",
+            "frame", "range", "points", "raw deg", "raw cm", "deg", "cm", "f_conv", "expl", "twin",
+            "ok", "ms",
         ]);
         for r in &report.frames {
             all.row(vec![
@@ -615,6 +629,12 @@ pub fn print(report: &CnnReport, frames: bool) {
                 num(r.err_deg, 2),
                 num(r.err_cm, 1),
                 format!("{:.1e}", r.f_conv_m2),
+                num(r.twins.explained, 3),
+                match (r.twins.twin, r.twins.twins_refined) {
+                    (Some(i), _) => format!("{i} used"),
+                    (None, 0) => "-".to_owned(),
+                    (None, n) => format!("{n} kept"),
+                },
                 r.success_refined.to_string(),
                 num(r.time_ms.total, 1),
             ]);
