@@ -14,6 +14,11 @@ pub struct Acquisition {
     pub attempts: Vec<Attempt>,
     /// Finite points of the frame.
     pub points: usize,
+    /// The chain's first method (reported when none was tried).
+    pub first_method: AcquisitionMethod,
+    /// Why no method was tried (too few finite points: no target in view),
+    /// if none was.
+    pub skipped: Option<String>,
     /// Wall time of the whole acquisition (ms).
     pub time_ms: f64,
 }
@@ -54,7 +59,8 @@ impl Acquisition {
         msg.time_ms = self.time_ms;
         msg.f_conv_m2 = f64::NAN;
         let reported = self.reported();
-        msg.method = reported.map_or(AcquisitionMethod::TemplateMatching, |a| a.method) as u8;
+        // A frame on which no method ran reports the first configured one.
+        msg.method = reported.map_or(self.first_method, |a| a.method) as u8;
         if let Some(Ok(out)) = reported.map(|a| &a.outcome) {
             msg.f_conv_m2 = out.f_conv_m2;
             if out.accepted {
@@ -67,6 +73,9 @@ impl Acquisition {
 
     /// One line for the log: each attempt's method, verdict, f_CONV and time.
     pub fn summary(&self) -> String {
+        if let Some(reason) = &self.skipped {
+            return format!("{} points: {reason}; no method tried", self.points);
+        }
         let parts: Vec<String> = self
             .attempts
             .iter()
@@ -107,6 +116,13 @@ impl MethodChain {
         })
     }
 
+    /// The first method (the chain holds at least one).
+    fn first_method(&self) -> AcquisitionMethod {
+        self.methods
+            .first()
+            .map_or(AcquisitionMethod::TemplateMatching, |m| m.method())
+    }
+
     /// The methods' kinds, in order.
     pub fn methods(&self) -> Vec<AcquisitionMethod> {
         self.methods.iter().map(|m| m.method()).collect()
@@ -116,22 +132,26 @@ impl MethodChain {
     pub fn acquire(&self, cloud: &[Point]) -> Acquisition {
         let started = Instant::now();
         let finite: Vec<Point> = cloud.iter().copied().filter(Point::is_finite).collect();
+        if finite.len() < self.min_points {
+            // No target in view (an empty frame from ingest, or a few stray
+            // points): no method can run, and none is blamed.
+            return Acquisition {
+                attempts: Vec::new(),
+                first_method: self.first_method(),
+                points: finite.len(),
+                skipped: Some(format!(
+                    "no target in view (too few points: {} finite of {}, need {})",
+                    finite.len(),
+                    cloud.len(),
+                    self.min_points
+                )),
+                time_ms: started.elapsed().as_secs_f64() * 1e3,
+            };
+        }
         let mut attempts = Vec::new();
         for m in &self.methods {
             let t0 = Instant::now();
-            let outcome = if finite.len() < self.min_points {
-                Err(InitError::Method {
-                    method: m.method().as_str(),
-                    reason: format!(
-                        "too few points: {} finite of {} (need {})",
-                        finite.len(),
-                        cloud.len(),
-                        self.min_points
-                    ),
-                })
-            } else {
-                m.acquire(&finite).and_then(|o| check_output(m.method(), o))
-            };
+            let outcome = m.acquire(&finite).and_then(|o| check_output(m.method(), o));
             let attempt = Attempt {
                 method: m.method(),
                 outcome,
@@ -145,7 +165,9 @@ impl MethodChain {
         }
         Acquisition {
             attempts,
+            first_method: self.first_method(),
             points: finite.len(),
+            skipped: None,
             time_ms: started.elapsed().as_secs_f64() * 1e3,
         }
     }

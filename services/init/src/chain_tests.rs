@@ -110,6 +110,9 @@ fn sparse_and_non_finite_clouds_fail_without_running_a_method() {
         assert_eq!(msg.success, 0);
         assert!(msg.f_conv_m2.is_nan());
         assert!(a.summary().contains("too few points"), "{}", a.summary());
+        assert!(a.summary().contains("no method tried"), "{}", a.summary());
+        assert!(a.attempts.is_empty());
+        assert_eq!(msg.method, AcquisitionMethod::TemplateMatching as u8);
     }
     assert_eq!(calls(&tm_calls), 0);
     // 20 finite points among NaNs are enough to try.

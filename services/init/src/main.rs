@@ -249,9 +249,9 @@ impl Node {
         };
         self.busy = false;
         let acquisition = &done.acquisition;
-        if done.points_in == 0 {
-            self.counters.rejected_empty += 1;
-        } else if acquisition.points < done.points_in {
+        // An empty frame is an observation (the target is not in view:
+        // ingest forwards it on purpose), not bad input: not counted.
+        if done.points_in > 0 && acquisition.points < done.points_in {
             self.counters.rejected_non_finite += 1;
         }
         let msg = acquisition.to_wire(done.sequence, done.scan_end_s, self.instance);
