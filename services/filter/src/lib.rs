@@ -11,7 +11,8 @@
 //!   (Eq. 12).
 //! - [`wire`]: conversions to and from the suite's messages (`FilterState`,
 //!   `PoseEstimate`, `AcquisitionResult`); [`selector`]: one estimate per
-//!   frame (primary/standby with a per-frame deadline); [`service`]: the logic of the `spacepose-filter` binary, bus-free;
+//!   frame (primary/standby with a per-frame deadline), with sticky
+//!   [`failover`] (promotion of the standby, revert); [`service`]: the logic of the `spacepose-filter` binary, bus-free;
 //!   [`snapshot`]: the state persisted for a restarted filter service.
 //!
 //! Units SI. `R = r_sensor_target` (target body → sensor), `p = p_sensor` the
@@ -22,6 +23,7 @@
 pub mod attitude;
 pub mod config;
 pub mod error;
+pub mod failover;
 pub mod filter;
 pub mod kalman;
 pub mod motion_compensation;
@@ -37,6 +39,7 @@ mod restart_tests;
 pub use attitude::AttitudeFilter;
 pub use config::FilterConfig;
 pub use error::FilterError;
+pub use failover::{ChangeCause, FailoverPolicy, RoleChange};
 pub use filter::{Prediction, RelativeMotionFilter, UpdateOutcome, covariance_from_information};
 pub use motion_compensation::MotionCompensation;
 pub use position::PositionFilter;

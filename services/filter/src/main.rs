@@ -6,7 +6,10 @@
 //! missing at the frame deadline, late or unusable) and publishes the
 //! `FilterState` after every change and every `state_period_ms` (heartbeat
 //! for late joiners). A `swap` command names the new primary (applied at
-//! the next undecided frame). Logic: [`FilterNode`].
+//! the next undecided frame). Failover is sticky: a standby that replaced
+//! a missing primary on `promote_after_misses` consecutive frames becomes
+//! the acting primary, and the preferred one takes the role back after
+//! `revert_after_frames` good frames (logged). Logic: [`FilterNode`].
 
 use anyhow::Context;
 use clap::Parser;
@@ -101,6 +104,9 @@ fn run(args: ServiceArgs) -> anyhow::Result<()> {
         changed |= drain_acquisitions(&ports, &mut node, &mut counters);
         changed |= drain_estimates(&ports, &mut node, &mut counters);
         changed |= report(node.poll(realtime_ns()), &mut counters);
+        for c in node.take_role_changes() {
+            tracing::warn!(from = c.from, to = c.to, cause = ?c.cause, from_frame = c.from_frame, "acting primary changed");
+        }
         if changed || state_period.is_some_and(|p| last_state.elapsed() >= p) {
             publish(&ports, &node, &mut counters);
             last_state = Instant::now();

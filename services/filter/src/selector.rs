@@ -16,9 +16,15 @@
 //! emitted in frame order: deciding frame `k` first decides every older
 //! frame still waiting, with what it has.
 //!
+//! Failover is sticky ([`crate::failover`]): after the primary missed its
+//! deadline on a few consecutive frames, the standby that replaced it is
+//! promoted and its estimates are taken on arrival; the displaced primary
+//! takes the role back once it delivers again.
+//!
 //! The selector is generic over the payload (the filter uses
 //! `PoseEstimate`), pure, and driven by the caller's clock (`now_ns`).
 
+use crate::failover::{FailoverPolicy, RoleChange, Roles};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// How usable an estimate is for fusion (judged by the caller).
@@ -108,43 +114,80 @@ struct Pending<T> {
 /// everything and takes it.
 #[derive(Debug, Clone)]
 pub struct FrameSelector<T> {
-    primary: Option<String>,
+    roles: Roles,
     deadline_ns: i64,
     window: u64,
     decided: BTreeSet<u64>,
     pending: BTreeMap<u64, Pending<T>>,
+    changes: Vec<RoleChange>,
 }
 
 impl<T: Clone> FrameSelector<T> {
     /// A selector with `primary` (none = first arrival wins), a per-frame
     /// deadline (ms after the cloud's publication) and a window of
-    /// `window` frames (at least 1).
+    /// `window` frames (at least 1), with the default [`FailoverPolicy`].
     pub fn new(primary: Option<String>, deadline_ms: f64, window: usize) -> Self {
         Self {
-            primary,
+            roles: Roles::new(primary, FailoverPolicy::default()),
             deadline_ns: (deadline_ms.max(0.0) * 1e6) as i64,
             window: window.max(1) as u64,
             decided: BTreeSet::new(),
             pending: BTreeMap::new(),
+            changes: Vec::new(),
         }
     }
 
-    /// The primary instance, if roles are configured.
-    pub fn primary(&self) -> Option<&str> {
-        self.primary.as_deref()
+    /// The same selector with another failover policy.
+    pub fn with_failover(mut self, policy: FailoverPolicy) -> Self {
+        let primary = self.roles.preferred().map(str::to_string);
+        self.roles = Roles::new(primary, policy);
+        self
     }
 
-    /// Makes `instance` the primary from the next undecided frame on (a
-    /// frame boundary: frames already decided stay decided). Held estimates
-    /// change role with it; a good one of the new primary is decided now.
+    /// The acting primary (the preferred one unless a standby was
+    /// promoted), if roles are configured.
+    pub fn primary(&self) -> Option<&str> {
+        self.roles.acting()
+    }
+
+    /// The preferred primary: the configured one, or the last swap's.
+    pub fn preferred(&self) -> Option<&str> {
+        self.roles.preferred()
+    }
+
+    /// The changes of the acting primary (promotions, reverts) since the
+    /// last call, oldest first.
+    pub fn take_role_changes(&mut self) -> Vec<RoleChange> {
+        std::mem::take(&mut self.changes)
+    }
+
+    /// Makes `instance` the (preferred and acting) primary from the next
+    /// undecided frame on (a frame boundary: frames already decided stay
+    /// decided). Held estimates change role with it; a good one of the new
+    /// primary is decided now.
     pub fn set_primary(&mut self, instance: &str) -> Vec<Choice<T>> {
-        self.primary = Some(instance.to_string());
+        self.roles.set(instance);
+        let out = self.reassign();
+        self.account(out)
+    }
+
+    /// The first frame not decided yet.
+    fn next_frame(&self) -> u64 {
+        self.newest().map_or(0, |n| n + 1)
+    }
+
+    /// Sorts the held estimates by the acting primary (after a role
+    /// change); decides the frames where it has a good one.
+    fn reassign(&mut self) -> Vec<Choice<T>> {
+        let Some(instance) = self.roles.acting().map(str::to_string) else {
+            return Vec::new();
+        };
         let mut ready = Vec::new();
         for (seq, p) in &mut self.pending {
             let mut all: Vec<Candidate<T>> = p.primary.take().into_iter().collect();
             all.extend(p.standby.take());
             for c in all {
-                if c.instance == instance {
+                if c.instance == instance.as_str() {
                     p.primary = Some(c);
                 } else {
                     p.standby = better_standby(p.standby.take(), c);
@@ -179,6 +222,52 @@ impl<T: Clone> FrameSelector<T> {
     /// Offers an estimate at time `now_ns`; returns what happened to it and
     /// the decisions made (in frame order, possibly for older frames too).
     pub fn offer(&mut self, c: Candidate<T>, now_ns: i64) -> (Offer, Vec<Choice<T>>) {
+        let on_time_good = now_ns <= self.deadline_of(&c, now_ns) && c.quality == Quality::Good;
+        let from_frame = self.next_frame();
+        let mut out = Vec::new();
+        if let Some(change) =
+            self.roles
+                .observe_offer(&c.instance, c.sequence, on_time_good, from_frame)
+        {
+            self.changes.push(change);
+            out = self.reassign();
+        }
+        let (offer, decided) = self.place(c, now_ns);
+        out.extend(decided);
+        (offer, self.account(out))
+    }
+
+    /// The deadline of `c`'s frame (ns).
+    fn deadline_of(&self, c: &Candidate<T>, now_ns: i64) -> i64 {
+        let base = if c.cloud_published_ns > 0 {
+            c.cloud_published_ns
+        } else {
+            now_ns
+        };
+        base.saturating_add(self.deadline_ns)
+    }
+
+    /// Tells the roles about `decided` (in frame order); on a promotion,
+    /// re-sorts the held estimates and decides what that makes ready.
+    fn account(&mut self, mut decided: Vec<Choice<T>>) -> Vec<Choice<T>> {
+        let mut done = 0;
+        while done < decided.len() {
+            for c in &decided[done..] {
+                self.roles
+                    .observe_decision(&c.candidate.instance, c.candidate.quality, c.reason);
+            }
+            done = decided.len();
+            if let Some(change) = self.roles.settle(self.next_frame()) {
+                self.changes.push(change);
+                let more = self.reassign();
+                decided.extend(more);
+            }
+        }
+        decided
+    }
+
+    /// The primary/standby rule for one estimate, under the current roles.
+    fn place(&mut self, c: Candidate<T>, now_ns: i64) -> (Offer, Vec<Choice<T>>) {
         if self.decided.contains(&c.sequence) {
             return (Offer::Duplicate, Vec::new());
         }
@@ -190,15 +279,10 @@ impl<T: Clone> FrameSelector<T> {
                 return (Offer::Stale, Vec::new());
             }
         }
-        let Some(primary) = self.primary.clone() else {
+        let Some(primary) = self.roles.acting().map(str::to_string) else {
             return (Offer::Chosen, self.decide(c, Reason::FirstArrival));
         };
-        let base = if c.cloud_published_ns > 0 {
-            c.cloud_published_ns
-        } else {
-            now_ns
-        };
-        let deadline_ns = base.saturating_add(self.deadline_ns);
+        let deadline_ns = self.deadline_of(&c, now_ns);
         let late = now_ns > deadline_ns;
         let seq = c.sequence;
         let pending = self.pending.entry(seq).or_insert(Pending {
@@ -245,7 +329,8 @@ impl<T: Clone> FrameSelector<T> {
 
     /// Decides every frame whose deadline has passed at `now_ns`.
     pub fn poll(&mut self, now_ns: i64) -> Vec<Choice<T>> {
-        self.expire(now_ns)
+        let out = self.expire(now_ns);
+        self.account(out)
     }
 
     fn expire(&mut self, now_ns: i64) -> Vec<Choice<T>> {
@@ -298,10 +383,12 @@ impl<T: Clone> FrameSelector<T> {
         }
     }
 
-    /// Forgets everything (e.g. after a re-initialisation).
+    /// Forgets every frame (e.g. after a re-initialisation); the roles
+    /// stay.
     pub fn reset(&mut self) {
         self.decided.clear();
         self.pending.clear();
+        self.roles.forget_frames();
     }
 }
 

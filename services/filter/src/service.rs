@@ -4,6 +4,7 @@
 
 use crate::config::FilterConfig;
 use crate::error::FilterError;
+use crate::failover::{FailoverPolicy, RoleChange};
 use crate::filter::RelativeMotionFilter;
 use crate::selector::{Candidate, Choice, FrameSelector, Offer, Quality, Reason};
 use crate::wire::{
@@ -35,6 +36,15 @@ pub struct FilterServiceConfig {
     /// Per-frame deadline (ms after the cloud's publication by ingest): a
     /// primary estimate later than this is replaced by a standby's.
     pub frame_deadline_ms: f64,
+    /// Sticky failover: after the acting primary missed its deadline on
+    /// this many consecutive frames, the standby that replaced it is
+    /// promoted (its estimates are then taken without waiting). 0: never.
+    /// Default 2 (see [`crate::failover`]).
+    pub promote_after_misses: u32,
+    /// The displaced primary takes the role back after this many
+    /// consecutive frames with a good estimate on time. 0: never (the
+    /// promoted standby stays primary). Default 5.
+    pub revert_after_frames: u32,
     /// A `tracking` estimate further than this from the filter's
     /// prediction (deg) is inconsistent: a standby's is preferred.
     pub max_disagreement_deg: f64,
@@ -65,6 +75,8 @@ impl Default for FilterServiceConfig {
             selector_window: 64,
             primary: None,
             frame_deadline_ms: 100.0,
+            promote_after_misses: FailoverPolicy::default().promote_after_misses,
+            revert_after_frames: FailoverPolicy::default().revert_after_frames,
             max_disagreement_deg: 10.0,
             max_disagreement_m: 0.5,
             snapshot_file: None,
@@ -75,6 +87,14 @@ impl Default for FilterServiceConfig {
 }
 
 impl FilterServiceConfig {
+    /// The failover policy of the selector.
+    pub fn failover(&self) -> FailoverPolicy {
+        FailoverPolicy {
+            promote_after_misses: self.promote_after_misses,
+            revert_after_frames: self.revert_after_frames,
+        }
+    }
+
     /// Checks every value.
     pub fn validate(&self) -> Result<(), FilterError> {
         self.filter.validate()?;
@@ -188,7 +208,8 @@ impl FilterNode {
                 config.primary.clone(),
                 config.frame_deadline_ms,
                 config.selector_window,
-            ),
+            )
+            .with_failover(config.failover()),
             max_disagreement_rad: config.max_disagreement_deg.to_radians(),
             max_disagreement_m: config.max_disagreement_m,
             updates: 0,
@@ -240,9 +261,20 @@ impl FilterNode {
         Ok(true)
     }
 
-    /// The primary instance of the selector (None: first arrival wins).
+    /// The acting primary instance of the selector (None: first arrival
+    /// wins): the preferred one, unless a standby was promoted.
     pub fn primary(&self) -> Option<&str> {
         self.selector.primary()
+    }
+
+    /// The preferred primary (configured, or named by the last swap).
+    pub fn preferred_primary(&self) -> Option<&str> {
+        self.selector.preferred()
+    }
+
+    /// Promotions and reverts of the acting primary since the last call.
+    pub fn take_role_changes(&mut self) -> Vec<RoleChange> {
+        self.selector.take_role_changes()
     }
 
     /// Makes `instance` the primary from the next undecided frame on (swap
@@ -550,5 +582,15 @@ mod tests {
             toml::from_str("primary = \"tracker-a\"\nframe_deadline_ms = 80.0\n").unwrap();
         assert_eq!(c.primary.as_deref(), Some("tracker-a"));
         c.validate().unwrap();
+        assert_eq!(c.failover(), FailoverPolicy::default());
+        let c: FilterServiceConfig =
+            toml::from_str("promote_after_misses = 3\nrevert_after_frames = 0\n").unwrap();
+        assert_eq!(
+            c.failover(),
+            FailoverPolicy {
+                promote_after_misses: 3,
+                revert_after_frames: 0
+            }
+        );
     }
 }
