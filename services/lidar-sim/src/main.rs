@@ -4,8 +4,16 @@
 //! `AcquisitionResult { method: truth }` for the first frame (published
 //! before that frame) — the documented exception until the init service
 //! exists (issue 5).
+//!
+//! A restarted instance continues the scenario where the dead one stopped:
+//! it resumes at the frame now due from the checkpoint its predecessor
+//! left (`checkpoint_file`, see [`checkpoint`] for why a checkpoint rather
+//! than a shared start instant); the frames missed meanwhile are missing.
+
+mod checkpoint;
 
 use anyhow::{Context, Result};
+use checkpoint::{Checkpoint, Resume};
 use clap::Parser;
 use serde::Deserialize;
 use spacepose_bus::{Bus, CloudPublisher, Publisher};
@@ -13,13 +21,14 @@ use spacepose_lidar_sim::{Frame, LidarSimulator, SensorConfig};
 use spacepose_messages::convert::{pose_to_wire, vector3_to_wire};
 use spacepose_messages::{
     AcquisitionMethod, AcquisitionResult, CloudHeader, MAX_POINTS, Name, Names, ServiceState,
-    TruthMsg,
+    TruthMsg, realtime_ns,
 };
 use spacepose_scenario::{LookAway, Scenario, ScenarioConfig, ScenarioKind, TruthState};
 use spacepose_service_kit::{
     Counters, HealthReporter, ServiceArgs, ServiceConfig, init_logging, load_config, shutdown_flag,
 };
 use spacepose_target::Target;
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
@@ -63,6 +72,13 @@ struct Config {
     /// `look_away = { first_frame = 8, frames = 4, angle_deg = 60.0 }`): the
     /// loss-and-reacquisition variant. Absent = never.
     look_away: Option<LookAway>,
+    /// File recording the last frame slot taken (written before each
+    /// frame); a restarted sensor resumes from it at the frame now due.
+    /// `spacepose up` sets `{run dir}/{instance}.sensorstate`. None: every
+    /// start begins at frame 0.
+    checkpoint_file: Option<PathBuf>,
+    /// A checkpoint older than this (s, wall clock) is ignored.
+    checkpoint_max_age_s: f64,
 }
 
 impl Default for Config {
@@ -82,6 +98,8 @@ impl Default for Config {
             exit_at_end: false,
             sensor_id: 0,
             look_away: None,
+            checkpoint_file: None,
+            checkpoint_max_age_s: 60.0,
         }
     }
 }
@@ -98,6 +116,7 @@ impl ServiceConfig for Config {
         positive("scale", self.scale)?;
         positive("range_m", self.range_m)?;
         positive("integration_time_s", self.integration_time_s)?;
+        positive("checkpoint_max_age_s", self.checkpoint_max_age_s)?;
         if let Some(look) = &self.look_away {
             look.validate().map_err(|e| e.to_string())?;
         }
@@ -221,8 +240,11 @@ fn run(args: &ServiceArgs) -> Result<()> {
     );
     let mut counters = Counters::default();
     health.send(&counters, ServiceState::Running as u8)?;
-    let mut next = Instant::now();
-    let mut k = 0u64;
+    let fingerprint = checkpoint::fingerprint(&format!("{config:?}"));
+    let start = starting_point(&config, fingerprint, period, &mut counters);
+    let wait_ns = start.slot_ns.saturating_sub(realtime_ns()).max(0);
+    let mut next = Instant::now() + Duration::from_nanos(wait_ns as u64);
+    let mut k = start.frame;
     let running = |bus: &Bus, d: Duration| -> Result<bool> {
         Ok(!shutdown.load(Ordering::Relaxed) && bus.sleep(d)?)
     };
@@ -243,6 +265,9 @@ fn run(args: &ServiceArgs) -> Result<()> {
         } else if shutdown.load(Ordering::Relaxed) {
             return stop(&mut health, &counters);
         }
+        // Before publishing: a crash in between loses frame k, never
+        // publishes it twice.
+        save_checkpoint(&config, k, fingerprint, &mut counters);
         match source.frame(k) {
             Ok(frame) => publish(&ports, &config, &frame, k, &mut counters),
             Err(e) => {
@@ -262,7 +287,74 @@ fn run(args: &ServiceArgs) -> Result<()> {
     stop(&mut health, &counters)
 }
 
-/// Acquisition (first frame, `truth_init`), then the cloud, then the truth.
+/// Where this instance starts: frame 0 now, or, after a restart, the frame
+/// due now on its predecessor's frame grid (from the checkpoint). A
+/// checkpoint that cannot be used is reported and frame 0 taken.
+fn starting_point(
+    config: &Config,
+    fingerprint: u64,
+    period: Option<Duration>,
+    counters: &mut Counters,
+) -> Resume {
+    let now = realtime_ns();
+    let fresh = Resume {
+        frame: 0,
+        slot_ns: now,
+    };
+    let Some(path) = &config.checkpoint_file else {
+        return fresh;
+    };
+    let period_ns = period.map(|p| i64::try_from(p.as_nanos()).unwrap_or(i64::MAX));
+    let max_age_ns = (config.checkpoint_max_age_s * 1e9) as i64;
+    match Checkpoint::load(path) {
+        Ok(None) => fresh,
+        Ok(Some(c)) if c.fingerprint != fingerprint => {
+            warn!(path = %path.display(), "checkpoint of another configuration ignored: starting at frame 0");
+            fresh
+        }
+        Ok(Some(c)) if now.saturating_sub(c.slot_ns) > max_age_ns => {
+            warn!(path = %path.display(), frame = c.frame, "checkpoint older than checkpoint_max_age_s ignored: starting at frame 0");
+            fresh
+        }
+        Ok(Some(c)) => {
+            let r = c.resume(now, period_ns);
+            info!(
+                last_frame = c.frame,
+                resume_frame = r.frame,
+                missed = r.frame - c.frame - 1,
+                due_in_ms = r.slot_ns.saturating_sub(now) as f64 * 1e-6,
+                "restarted: resuming the scenario at the frame now due"
+            );
+            r
+        }
+        Err(e) => {
+            warn!("{e:#}: starting at frame 0");
+            counters.errors += 1;
+            fresh
+        }
+    }
+}
+
+/// Records that frame `k` takes its slot now.
+fn save_checkpoint(config: &Config, k: u64, fingerprint: u64, counters: &mut Counters) {
+    let Some(path) = &config.checkpoint_file else {
+        return;
+    };
+    let c = Checkpoint {
+        frame: k,
+        slot_ns: realtime_ns(),
+        fingerprint,
+    };
+    if let Err(e) = c.save(path) {
+        warn!(sequence = k, "{e:#}");
+        counters.errors += 1;
+    }
+}
+
+/// Acquisition (first frame, `truth_init`), then the truth, then the cloud:
+/// once the cloud is out, the scorers have the frame's truth, even if the
+/// sensor dies right after (a kill between the two would otherwise leave a
+/// tracked frame without truth).
 fn publish(ports: &Ports, config: &Config, frame: &Frame, k: u64, c: &mut Counters) {
     c.frames_in += 1;
     if k == 0 && config.truth_init {
@@ -277,6 +369,10 @@ fn publish(ports: &Ports, config: &Config, frame: &Frame, k: u64, c: &mut Counte
             warn!("publishing the truth acquisition: {e}");
             c.errors += 1;
         }
+    }
+    if let Err(e) = ports.truth.send(&truth_msg(k, &frame.truth)) {
+        warn!(sequence = k, "publishing the truth: {e}");
+        c.errors += 1;
     }
     let mut header = CloudHeader::new(k, frame.scan_start, frame.scan_end);
     header.sensor_id = config.sensor_id;
@@ -293,10 +389,6 @@ fn publish(ports: &Ports, config: &Config, frame: &Frame, k: u64, c: &mut Counte
                 c.errors += 1;
             }
         }
-    }
-    if let Err(e) = ports.truth.send(&truth_msg(k, &frame.truth)) {
-        warn!(sequence = k, "publishing the truth: {e}");
-        c.errors += 1;
     }
 }
 

@@ -67,11 +67,12 @@ pub fn start(plan: &Plan, watch: &mut HealthWatch, out: &mut dyn Write) -> Resul
     let dir = run_dir(&prefix);
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     // NDT maps cached by an earlier run of this prefix may be of another
-    // target; filter snapshots are of another run (restarts keep both).
+    // target; filter snapshots and sensor checkpoints are of another run
+    // (restarts keep all three).
     for e in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
         if e.path()
             .extension()
-            .is_some_and(|x| x == "ndtmap" || x == "filterstate")
+            .is_some_and(|x| x == "ndtmap" || x == "filterstate" || x == "sensorstate")
         {
             let _ = std::fs::remove_file(e.path());
         }

@@ -88,8 +88,11 @@ pub fn truth_init(config: &toml::Table) -> bool {
 /// built on the first start and loaded by every restart, so a restarted
 /// tracker is back within a fraction of a second instead of rebuilding it;
 /// the state snapshot of a filter (`snapshot_file`, `{name}.filterstate`,
-/// from which a restarted filter resumes) and the statistics file of a
-/// bridge (`stats_file`, `{name}.stats.json`), in the same directory.
+/// from which a restarted filter resumes), the checkpoint of a simulated
+/// sensor (`checkpoint_file`, `{name}.sensorstate`, from which a restarted
+/// lidar-sim continues the scenario at the frame now due) and the
+/// statistics file of a bridge (`stats_file`, `{name}.stats.json`), in the
+/// same directory.
 pub fn deployment_config(
     kind: ServiceKind,
     config: &toml::Table,
@@ -110,6 +113,9 @@ pub fn deployment_config(
     };
     if kind == ServiceKind::Filter && !config.contains_key("snapshot_file") {
         config.insert("snapshot_file".into(), file("filterstate"));
+    }
+    if kind == ServiceKind::LidarSim && !config.contains_key("checkpoint_file") {
+        config.insert("checkpoint_file".into(), file("sensorstate"));
     }
     if kind == ServiceKind::Bridge && !config.contains_key("stats_file") {
         config.insert("stats_file".into(), file("stats.json"));
@@ -326,6 +332,9 @@ mod tests {
             t.config["zenoh"]["listen"][0].as_str(),
             Some(super::super::descriptor::DEFAULT_LISTEN)
         );
+        // A restarted sensor resumes from its checkpoint in the run dir.
+        let sim = last[0].config["checkpoint_file"].as_str().unwrap();
+        assert!(sim.ends_with("/sim.sensorstate"), "{sim}");
     }
 
     #[test]
