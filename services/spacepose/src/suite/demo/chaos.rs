@@ -105,6 +105,10 @@ pub struct ChaosReport {
     /// Frames whose cloud came after the injection until the fault was
     /// detected: the filter's frame deadline covers them (standby takes over).
     pub first_frame_after: Option<u64>,
+    /// Injection → that frame's cloud published (ms): for a killed sensor,
+    /// the outage the pipeline saw (a restarted sensor resumes at the frame
+    /// then due, it does not replay).
+    pub first_frame_after_ms: Option<f64>,
     /// Cloud published → fused filter state, for the first frame after
     /// the injection (ms): the standby's takeover time when the primary
     /// tracker was hit.
@@ -151,6 +155,8 @@ impl Injection {
             restart_ms: fault.and_then(|f| f.healthy_at.map(|t| ms(f.detected_at, t))),
             decision: fault.map(|f| f.decision.clone()).unwrap_or_default(),
             first_frame_after: first_after.map(|f| f.0),
+            first_frame_after_ms: first_after
+                .map(|(_, cloud, _)| (cloud - self.at_ns) as f64 * 1e-6),
             takeover_ms: first_after
                 .and_then(|(_, cloud, fused)| fused.map(|f| (f - cloud) as f64 * 1e-6)),
         }

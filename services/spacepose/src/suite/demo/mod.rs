@@ -270,7 +270,11 @@ fn follow(
             swap = None;
         }
         sup.step(out)?;
-        let done = scorer.truths() as u64 >= opts.frames
+        // Every frame produced: all of them, or up to the last one (a
+        // restarted sensor does not replay the frames it missed).
+        let produced = scorer.truths() as u64 >= opts.frames
+            || scorer.newest_truth().is_some_and(|k| k + 1 >= opts.frames);
+        let done = produced
             && scorer.scored().len() + scorer.unscorable as usize >= scorer.truths()
             && !sup.swapping();
         // Once every frame has a pose, wait a little for the filter states

@@ -86,13 +86,15 @@ pub fn chaos_lines(s: &Summary) -> String {
     let mut text = String::new();
     for c in &s.chaos {
         text.push_str(&format!(
-            "chaos {:?} {} @{}: detected by {} after {} ms; restarted (first heartbeat) {} ms after detection; takeover {} ms\n",
+            "chaos {:?} {} @{}: detected by {} after {} ms; restarted (first heartbeat) {} ms after detection; next frame {} ({} ms after), takeover {} ms\n",
             c.action,
             c.instance,
             c.at_frame,
             if c.detected_by.is_empty() { "-" } else { &c.detected_by },
             opt(c.detection_ms),
             opt(c.restart_ms),
+            c.first_frame_after.map_or("-".to_string(), |k| k.to_string()),
+            opt(c.first_frame_after_ms),
             opt(c.takeover_ms),
         ));
     }

@@ -152,6 +152,12 @@ impl Scorer {
         self.truth.len()
     }
 
+    /// The newest frame the sensor produced (a restarted sensor skips the
+    /// frames due while it was dead, so this can be ahead of `truths`).
+    pub fn newest_truth(&self) -> Option<u64> {
+        self.truth.keys().next_back().copied()
+    }
+
     /// Frames with a scored pose.
     pub fn scored(&self) -> &BTreeMap<u64, FrameScore> {
         &self.scored
@@ -218,6 +224,17 @@ impl Spread {
     }
 }
 
+/// The fusion latency of one frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct FusionTime {
+    /// Frame sequence.
+    pub sequence: u64,
+    /// When ingest published its cloud (ns, CLOCK_REALTIME).
+    pub cloud_published_ns: i64,
+    /// Cloud published by ingest → filter state published (ms).
+    pub latency_ms: Option<f64>,
+}
+
 /// The summary of a run (the `--json` file).
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
@@ -261,6 +278,9 @@ pub struct Summary {
     /// Cloud published by ingest → filter state of that frame published
     /// (ms): includes the wait for the primary up to the frame deadline.
     pub fusion_latency_ms: Spread,
+    /// Per frame with a pose: cloud published by ingest → filter state of
+    /// that frame published (ms; null when no state at its time was seen).
+    pub fusions: Vec<FusionTime>,
     /// Injected faults and what the supervisor did (`--chaos`).
     pub chaos: Vec<ChaosReport>,
     /// The run-time swap (`--swap`).
@@ -323,6 +343,15 @@ impl Summary {
                     .filter_map(|(_, cloud, fused)| fused.map(|f| (f - cloud) as f64 * 1e-6))
                     .collect::<Vec<_>>(),
             ),
+            fusions: scorer
+                .fusions()
+                .iter()
+                .map(|(sequence, cloud, fused)| FusionTime {
+                    sequence: *sequence,
+                    cloud_published_ns: *cloud,
+                    latency_ms: fused.map(|f| (f - cloud) as f64 * 1e-6),
+                })
+                .collect(),
             chaos: Vec::new(),
             swap: None,
             restarts: BTreeMap::new(),
