@@ -92,6 +92,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let t = frame.truth.t_sensor_target.translation;
             let r = spacepose_acquisition::refine(
                 m.icp_model(),
+                m.stage_model(),
                 &frame.points,
                 &spacepose_geometry::Pose::new(*g, t),
                 m.config(),

@@ -53,6 +53,8 @@ pub struct TemplateMatcher {
     renderer: TemplateRenderer,
     coarse_renderer: Option<TemplateRenderer>,
     icp_model: IcpModel,
+    /// The coarser model of the wide ICP stages, if configured.
+    stage_model: Option<IcpModel>,
 }
 
 impl TemplateMatcher {
@@ -77,6 +79,12 @@ impl TemplateMatcher {
             .map(|c| TemplateRenderer::new(target.clone(), &sensor, c.stride));
         let model = target.sample_surface(config.model_spacing_m, MODEL_SEED);
         let icp_model = IcpModel::new(&model)?;
+        let stage_model = if config.stage_model_spacing_m > 0.0 {
+            let coarse = target.sample_surface(config.stage_model_spacing_m, MODEL_SEED);
+            Some(IcpModel::new(&coarse)?)
+        } else {
+            None
+        };
         Ok(Self {
             target,
             sensor,
@@ -85,6 +93,7 @@ impl TemplateMatcher {
             renderer,
             coarse_renderer,
             icp_model,
+            stage_model,
         })
     }
 
@@ -106,6 +115,12 @@ impl TemplateMatcher {
     /// The ICP model (target surface sample with its lookup structures).
     pub fn icp_model(&self) -> &IcpModel {
         &self.icp_model
+    }
+
+    /// The model of the wide ICP stages (the ICP model when
+    /// `stage_model_spacing_m` is 0).
+    pub fn stage_model(&self) -> &IcpModel {
+        self.stage_model.as_ref().unwrap_or(&self.icp_model)
     }
 
     /// The grid attitudes `(Euler angles, rotation)`.
@@ -200,7 +215,14 @@ impl TemplateMatcher {
         let refined: Vec<Result<Refined, String>> = candidates
             .iter()
             .map(|(_, pose)| {
-                refine(&self.icp_model, &finite, pose, &self.config).map_err(|e| e.to_string())
+                refine(
+                    &self.icp_model,
+                    self.stage_model(),
+                    &finite,
+                    pose,
+                    &self.config,
+                )
+                .map_err(|e| e.to_string())
             })
             .collect();
         let refinement_ms = ms_since(refine_start);

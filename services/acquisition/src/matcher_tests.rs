@@ -140,6 +140,7 @@ fn single_thread_and_parallel_agree() {
         renderer: m.renderer.clone(),
         coarse_renderer: None,
         icp_model: IcpModel::new(&m.target.sample_surface(0.3, 1)).unwrap(),
+        stage_model: None,
     };
     let r = Euler321::from_degrees(-70.0, -20.0, 50.0).to_rotation();
     let cloud = frame(

@@ -20,10 +20,12 @@ pub struct Refined {
     pub inlier_fraction: f64,
 }
 
-/// Runs the wide stages of `config.icp_stages_m`, then `config.icp`, from
-/// `t_sensor_target`; f_CONV is that of the final stage.
+/// Runs the wide stages of `config.icp_stages_m` on `stage_model`, then
+/// `config.icp` on `model`, from `t_sensor_target`; f_CONV is that of the
+/// final stage.
 pub fn refine(
     model: &IcpModel,
+    stage_model: &IcpModel,
     cloud: &[Point],
     t_sensor_target: &Pose,
     config: &TemplateMatchingConfig,
@@ -37,7 +39,7 @@ pub fn refine(
             termination_increment: config.icp.termination_increment.max(1e-4),
             ..config.icp
         };
-        let r = register_icp(model, cloud, &t_target_sensor, &params)?;
+        let r = register_icp(stage_model, cloud, &t_target_sensor, &params)?;
         iterations += r.iterations;
         t_target_sensor = r.t_target_sensor;
     }

@@ -66,7 +66,7 @@ pub struct TmOptions {
     #[arg(long)]
     pub trimmed: bool,
     /// Best templates refined by ICP, lowest f_CONV kept (1 = seed 002).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 4)]
     pub icp_candidates: usize,
     /// Ray thinning of every template (1 = every sensor ray).
     #[arg(long, default_value_t = 1)]
