@@ -6,7 +6,7 @@
 use crate::error::RegistrationError;
 use crate::gauss_newton;
 use crate::ndt_map::NdtMap;
-use crate::normal_equations::NormalEquations;
+use crate::normal_equations::{Constrained, NormalEquations};
 use crate::params::NdtParams;
 use crate::result::Registration;
 use crate::source::{check_pose, position_is_finite};
@@ -259,11 +259,34 @@ pub fn register_ct_ndt(
         });
     }
     let skipped = source.len() - points.len();
+    // Degeneracy handling (`NdtParams::min_lever_arm_m`) on the end pose:
+    // its directions come from the rigid geometric information of the cloud
+    // placed at the initial end pose (Eq. 15 scales each point's Jacobian
+    // by its interpolation factor, which weighs the points but does not
+    // change which rotations the surface leaves free).
+    let constrained = (params.min_lever_arm_m > 0.0)
+        .then(|| {
+            let positions: Vec<Vector3<f64>> = source
+                .iter()
+                .filter(|p| position_is_finite(p) && p.t.is_finite())
+                .map(Point::position)
+                .collect();
+            let (h, n) = crate::ndt::geometric_information(
+                map,
+                &positions,
+                initial_t_target_sensor_end,
+                1,
+                params,
+            );
+            Constrained::of(&h, n, params.min_lever_arm_m)
+        })
+        .flatten();
     gauss_newton::run(
         *initial_t_target_sensor_end,
         params,
         points.len(),
         skipped,
+        constrained.as_ref(),
         |end, stride| linearise(map, &points, t_target_sensor_start, end, stride, params),
     )
 }

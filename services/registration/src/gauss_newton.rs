@@ -3,7 +3,7 @@
 //! increment (Table 1).
 
 use crate::error::RegistrationError;
-use crate::normal_equations::{NormalEquations, increment_of};
+use crate::normal_equations::{Constrained, NormalEquations, increment_of};
 use crate::params::NdtParams;
 use crate::result::{Cost, Increment, Registration};
 use spacepose_geometry::Pose;
@@ -22,11 +22,15 @@ use spacepose_geometry::Pose;
 /// (full) linearisation, i.e. at the pose before the last increment, which
 /// is below the termination thresholds (0.05°, 1 mm by default); otherwise
 /// a final evaluation at the returned pose.
+///
+/// `constrained`: increments restricted to its well-constrained directions
+/// (see `NdtParams::min_lever_arm_m`); `None`: the full Eq. (7).
 pub(crate) fn run(
     initial: Pose,
     params: &NdtParams,
     valid_points: usize,
     skipped_non_finite: usize,
+    constrained: Option<&Constrained>,
     mut linearise: impl FnMut(&Pose, usize) -> NormalEquations,
 ) -> Result<Registration, RegistrationError> {
     let no_match = |iteration| RegistrationError::NoCorrespondences {
@@ -53,7 +57,10 @@ pub(crate) fn run(
         if ne.inliers == 0 {
             return Err(no_match(it));
         }
-        let eps = ne.solve(it)?;
+        let eps = match constrained {
+            Some(c) => ne.solve_in(&c.basis, it)?,
+            None => ne.solve(it)?,
+        };
         pose = pose.oplus(&eps); // T ← ε ⊕ T, Eq. (5)
         iterations = it + 1;
         last = increment_of(&eps);
@@ -89,5 +96,7 @@ pub(crate) fn run(
         f_conv_m2: None,
         information: ne.hessian(),
         last_increment: last,
+        degenerate_directions: constrained.map_or(0, Constrained::dropped),
+        weakest_lever_arm_m: constrained.map_or(f64::NAN, |c| c.weakest_lever_arm_m),
     })
 }

@@ -336,6 +336,8 @@ pub fn register_icp(
         f_conv_m2: Some(all_d2 / points.len() as f64),
         information: ne.hessian() / sigma2,
         last_increment: last,
+        degenerate_directions: 0,
+        weakest_lever_arm_m: f64::NAN,
     })
 }
 

@@ -5,11 +5,11 @@
 use crate::error::RegistrationError;
 use crate::gauss_newton;
 use crate::ndt_map::NdtMap;
-use crate::normal_equations::NormalEquations;
+use crate::normal_equations::{Constrained, NormalEquations};
 use crate::params::NdtParams;
 use crate::result::Registration;
 use crate::source::{check_pose, finite_positions};
-use nalgebra::Vector3;
+use nalgebra::{Matrix6, Vector3};
 use spacepose_geometry::{Point, Pose};
 
 /// Normal equations of Eq. (7) at `t` over every `stride`-th point: each point `z_i` is associated with
@@ -36,6 +36,29 @@ pub(crate) fn linearise(
     ne
 }
 
+/// The geometric information at `t` over every `stride`-th point: each
+/// associated point adds `Jᵀ n nᵀ J` with `n` its cell's normal (what the
+/// surface constrains; see `NdtParams::degeneracy_ratio`).
+pub(crate) fn geometric_information(
+    map: &NdtMap,
+    points: &[Vector3<f64>],
+    t: &Pose,
+    stride: usize,
+    params: &NdtParams,
+) -> (Matrix6<f64>, usize) {
+    let rotation = t.rotation.matrix();
+    let mut ne = NormalEquations::new();
+    for z in points.iter().step_by(stride.max(1)) {
+        let rz = rotation * z;
+        let x = rz + t.translation;
+        if let Some((k, _)) = map.nearest_cell(&x, params.max_distance_m, params.lookup) {
+            let (mean, n) = map.mean_and_normal(k);
+            ne.add_rigid(&rz, &(n * n.transpose()), &(x - mean));
+        }
+    }
+    (ne.hessian(), ne.inliers)
+}
+
 /// Registers `source` (sensor frame) against the smoothed NDT `map`
 /// (target body frame), starting from `initial_t_target_sensor`.
 ///
@@ -56,14 +79,25 @@ pub fn register_ndt(
     params.validate()?;
     check_pose("initial_t_target_sensor", initial_t_target_sensor)?;
     let (points, skipped) = finite_positions(source)?;
+    let constrained = (params.min_lever_arm_m > 0.0)
+        .then(|| {
+            let (h, n) = geometric_information(map, &points, initial_t_target_sensor, 1, params);
+            Constrained::of(&h, n, params.min_lever_arm_m)
+        })
+        .flatten();
     gauss_newton::run(
         *initial_t_target_sensor,
         params,
         points.len(),
         skipped,
+        constrained.as_ref(),
         |t, stride| linearise(map, &points, t, stride, params),
     )
 }
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+#[path = "ndt/degeneracy_tests.rs"]
+mod degeneracy_tests;

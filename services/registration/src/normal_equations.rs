@@ -134,6 +134,103 @@ impl NormalEquations {
     }
 }
 
+/// The well-constrained directions of a geometric information matrix
+/// (see `NdtParams::min_lever_arm_m`).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Constrained {
+    /// Basis of the directions kept, in `δ = [rot; trans]` coordinates.
+    pub basis: Vec<Vector6<f64>>,
+    /// The weakest rotation's lever arm: `√(λ_min / N)` of the rotation
+    /// block with the translation marginalised out (m).
+    pub weakest_lever_arm_m: f64,
+}
+
+impl Constrained {
+    /// From the geometric information `h = Σ Jᵀ n nᵀ J` of `n` points: the
+    /// rotation information with the translation marginalised out (Schur
+    /// complement `H_rr − H_rt H_tt⁻¹ H_tr`) is eigen-decomposed; a
+    /// rotation axis whose mean squared lever arm `λ / n` is below
+    /// `min_lever_arm_m²` is left out (a 1 rad turn about it moves the
+    /// points along their normals by less than that, on average). The three
+    /// translations are always kept. `None` when the translation block is
+    /// singular or `h` is not finite.
+    pub(crate) fn of(h: &Matrix6<f64>, n: usize, min_lever_arm_m: f64) -> Option<Self> {
+        if n == 0 || !h.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        let h_rr = h.fixed_view::<3, 3>(0, 0).into_owned();
+        let h_rt = h.fixed_view::<3, 3>(0, 3).into_owned();
+        let h_tt = h.fixed_view::<3, 3>(3, 3).into_owned();
+        let h_tt_inv = h_tt.try_inverse()?;
+        let schur = h_rr - h_rt * h_tt_inv * h_rt.transpose();
+        let eig = ((schur + schur.transpose()) * 0.5).symmetric_eigen();
+        let min2 = min_lever_arm_m * min_lever_arm_m;
+        let mut basis: Vec<Vector6<f64>> = (0..3)
+            .filter(|&i| eig.eigenvalues[i] / n as f64 >= min2)
+            .map(|i| {
+                let v = eig.eigenvectors.column(i);
+                Vector6::new(v[0], v[1], v[2], 0.0, 0.0, 0.0)
+            })
+            .collect();
+        for k in 3..6 {
+            let mut e = Vector6::zeros();
+            e[k] = 1.0;
+            basis.push(e);
+        }
+        let weakest = eig.eigenvalues.min().max(0.0) / n as f64;
+        Some(Self {
+            basis,
+            weakest_lever_arm_m: weakest.sqrt(),
+        })
+    }
+
+    /// Directions left out.
+    pub(crate) fn dropped(&self) -> usize {
+        6 - self.basis.len()
+    }
+}
+
+impl NormalEquations {
+    /// Solves Eq. (7) restricted to `span(basis)`: `ε = Q y` with
+    /// `(Qᵀ H Q) y = -Qᵀ g`. The full basis gives [`NormalEquations::solve`].
+    pub(crate) fn solve_in(
+        &self,
+        basis: &[Vector6<f64>],
+        iteration: usize,
+    ) -> Result<Vector6<f64>, RegistrationError> {
+        if basis.len() == 6 {
+            return self.solve(iteration);
+        }
+        let degenerate = RegistrationError::DegenerateSystem {
+            iteration,
+            inliers: self.inliers,
+        };
+        let k = basis.len();
+        if k == 0 {
+            return Err(degenerate);
+        }
+        let q = nalgebra::DMatrix::from_fn(6, k, |i, j| basis[j][i]);
+        let h6 = self.hessian();
+        let h = nalgebra::DMatrix::from_fn(6, 6, |i, j| h6[(i, j)]);
+        let g = nalgebra::DVector::from_vec(vec![
+            self.g_r.x, self.g_r.y, self.g_r.z, self.g_t.x, self.g_t.y, self.g_t.z,
+        ]);
+        let a = q.transpose() * &h * &q;
+        let b = q.transpose() * g;
+        let y = a.cholesky().ok_or(degenerate)?.solve(&b);
+        let eps = -(q * y);
+        let eps = Vector6::from_iterator(eps.iter().copied());
+        if eps.iter().all(|v| v.is_finite()) {
+            Ok(eps)
+        } else {
+            Err(RegistrationError::DegenerateSystem {
+                iteration,
+                inliers: self.inliers,
+            })
+        }
+    }
+}
+
 /// Sizes of an increment `ε = [rot; trans]`.
 pub(crate) fn increment_of(eps: &Vector6<f64>) -> Increment {
     Increment {

@@ -130,6 +130,23 @@ pub struct NdtParams {
     /// the termination thresholds; later iterations and the convergence
     /// test use every point.
     pub coarse_switch: f64,
+    /// Degeneracy handling of `register_ndt`, not in seed 000 (after the
+    /// "solution remapping" of Zhang, Kaess and Singh, ICRA 2016). Before
+    /// the Gauss-Newton loop, the *geometric* information at the initial
+    /// pose, `Σ Jᵀ n nᵀ J` with `n` the normal of each point's cell (what
+    /// the surface constrains, point-to-plane), gives the rotation
+    /// information with the translation marginalised out. A rotation axis
+    /// whose mean squared lever arm (eigenvalue over points) is below this
+    /// squared gets no increment: the pose keeps the initial guess there
+    /// (the filter prediction in `deblur` mode). NDT's own information is
+    /// no guide: its cells have a finite extent along the surface, so a
+    /// plane seems to constrain turning within itself and pulls the points
+    /// toward the cell means. Seen end-on at 3 m, deos shows a plane and a
+    /// cylinder (its MLI face and tower): the roll about the tower is then
+    /// unobservable, and NDT held it still while the target spun. 0
+    /// disables it (the paper).
+    #[serde(default)]
+    pub min_lever_arm_m: f64,
 }
 
 impl Default for NdtParams {
@@ -142,6 +159,7 @@ impl Default for NdtParams {
             lookup: CellLookup::Grid,
             coarse_stride: 4,
             coarse_switch: 5.0,
+            min_lever_arm_m: 0.0,
         }
     }
 }
@@ -153,6 +171,12 @@ impl NdtParams {
         check_positive("termination_rotation_deg", self.termination_rotation_deg)?;
         check_positive("termination_translation_m", self.termination_translation_m)?;
         check_positive("coarse_switch", self.coarse_switch)?;
+        if !(self.min_lever_arm_m.is_finite() && self.min_lever_arm_m >= 0.0) {
+            return Err(RegistrationError::param(
+                "min_lever_arm_m",
+                "must be finite and >= 0",
+            ));
+        }
         if self.max_iterations == 0 {
             return Err(RegistrationError::param("max_iterations", "must be >= 1"));
         }

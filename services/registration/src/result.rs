@@ -61,6 +61,13 @@ pub struct Registration {
     pub information: Matrix6<f64>,
     /// The last increment.
     pub last_increment: Increment,
+    /// Rotation axes left at the initial guess as unobservable
+    /// (`NdtParams::min_lever_arm_m`; 0 when off, for CT-NDT and ICP).
+    pub degenerate_directions: usize,
+    /// The weakest rotation's lever arm in the geometric information at the
+    /// initial pose (m; NaN when not computed: degeneracy handling off,
+    /// CT-NDT, ICP). Near 0: a rotation the surface does not constrain.
+    pub weakest_lever_arm_m: f64,
 }
 
 impl Registration {

@@ -313,6 +313,11 @@ pub struct EvalTrackingArgs {
     /// learns the angular velocity (seed 000 §5.2).
     #[arg(long, default_value_t = 10)]
     pub warmup: usize,
+    /// NDT degeneracy handling: rotations with a smaller lever arm are
+    /// held at the prediction (`NdtParams::min_lever_arm_m`, m; 0 = the
+    /// paper). Default: the tracker's.
+    #[arg(long)]
+    pub min_lever_arm_m: Option<f64>,
     /// Write the results as JSON.
     #[arg(long)]
     pub json: Option<PathBuf>,

@@ -167,11 +167,13 @@ impl NdtMap {
         let mut grid = body.grid;
         grid.pack(&means);
         let tree = build_tree(&means).map_err(|e| e.to_string())?;
+        let covariances: Vec<_> = body.covariances.iter().map(array_to_sym).collect();
         Ok(Self {
             params: body.params,
             model_points: body.model_points as usize,
             means,
-            covariances: body.covariances.iter().map(array_to_sym).collect(),
+            normals: super::normals_of(&covariances),
+            covariances,
             inv_covariances: body.inv_covariances.iter().map(array_to_sym).collect(),
             counts: body.counts,
             grid,

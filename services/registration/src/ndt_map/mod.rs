@@ -62,8 +62,24 @@ pub struct NdtMap {
     covariances: Vec<Matrix3<f64>>,
     inv_covariances: Vec<Matrix3<f64>>,
     counts: Vec<u32>,
+    /// Unit normal of each cell: the eigenvector of the smallest eigenvalue
+    /// of its smoothed covariance (derived, not stored in map files).
+    normals: Vec<Vector3<f64>>,
     grid: LookupGrid,
     tree: Tree3,
+}
+
+/// The unit normal of each covariance (eigenvector of its smallest
+/// eigenvalue).
+pub(crate) fn normals_of(covariances: &[Matrix3<f64>]) -> Vec<Vector3<f64>> {
+    covariances
+        .iter()
+        .map(|c| {
+            let e = c.symmetric_eigen();
+            let i = e.eigenvalues.imin();
+            e.eigenvectors.column(i).normalize()
+        })
+        .collect()
 }
 
 impl NdtMap {
@@ -132,6 +148,7 @@ impl NdtMap {
             params.max_lookup_voxels,
         );
         let tree = build_tree(&means)?;
+        let normals = normals_of(&covariances);
         Ok(Self {
             params: *params,
             model_points: model.len(),
@@ -139,6 +156,7 @@ impl NdtMap {
             covariances,
             inv_covariances,
             counts,
+            normals,
             grid,
             tree,
         })
@@ -220,6 +238,12 @@ impl NdtMap {
             .nearest_one::<SquaredEuclidean<f64>>()
             .execute();
         (hit.distance <= max2).then_some((hit.item as usize, hit.distance))
+    }
+
+    /// `(μ̃_k, n_k)`: the mean and unit normal of cell `k`.
+    #[inline]
+    pub(crate) fn mean_and_normal(&self, k: usize) -> (&Vector3<f64>, &Vector3<f64>) {
+        (&self.means[k], &self.normals[k])
     }
 
     /// `(μ̃_k, C̃_k⁻¹)` without bounds checks beyond the slice's own.

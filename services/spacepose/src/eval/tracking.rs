@@ -63,6 +63,8 @@ pub struct EvalConfig {
     pub target: (String, f64),
     /// Frames excluded from the converged statistics.
     pub warmup: usize,
+    /// Overrides the tracker's NDT `min_lever_arm_m`.
+    pub min_lever_arm_m: Option<f64>,
 }
 
 /// One frame of one mode.
@@ -88,6 +90,10 @@ pub struct FrameRecord {
     pub cost_mean: f64,
     /// Fraction of the used points with a correspondence.
     pub inlier_fraction: f64,
+    /// Directions left at the prediction as unobservable.
+    pub degenerate_directions: usize,
+    /// The weakest rotation's lever arm (m; NaN when not computed).
+    pub weakest_lever_arm_m: f64,
     /// Raw points in the frame.
     pub points_in: usize,
     /// Points after pre-processing.
@@ -232,7 +238,11 @@ fn start_trackers(
         .modes
         .iter()
         .map(|&mode| {
-            let mut tracker = Tracker::new(TrackerConfig::with_mode(mode), model.clone())?;
+            let mut tracker_config = TrackerConfig::with_mode(mode);
+            if let Some(lever) = config.min_lever_arm_m {
+                tracker_config.ndt.min_lever_arm_m = lever;
+            }
+            let mut tracker = Tracker::new(tracker_config, model.clone())?;
             tracker.initialize(t0, &pose0, Vector3::zeros(), Vector3::zeros())?;
             Ok(tracker)
         })
@@ -278,6 +288,14 @@ fn track_frame(tracker: &mut Tracker, frame: &Frame, index: usize) -> Result<Fra
             .registration
             .as_ref()
             .map_or(f64::NAN, |r| r.inlier_fraction()),
+        degenerate_directions: out
+            .registration
+            .as_ref()
+            .map_or(0, |r| r.degenerate_directions),
+        weakest_lever_arm_m: out
+            .registration
+            .as_ref()
+            .map_or(f64::NAN, |r| r.weakest_lever_arm_m),
         points_in: out.points_in,
         points_used: out.points_used,
         reason: out.reason,
@@ -414,6 +432,7 @@ pub fn run(args: &EvalTrackingArgs) -> Result<()> {
         first_frame: args.first_frame,
         target: (args.target.clone(), args.scale),
         warmup: args.warmup,
+        min_lever_arm_m: args.min_lever_arm_m,
     };
     let report = evaluate(&config)?;
     print!("{}", render(&report));
