@@ -98,5 +98,6 @@ pub(crate) fn run(
         last_increment: last,
         degenerate_directions: constrained.map_or(0, Constrained::dropped),
         weakest_lever_arm_m: constrained.map_or(f64::NAN, |c| c.weakest_lever_arm_m),
+        geometric_information: constrained.map(|c| c.information),
     })
 }

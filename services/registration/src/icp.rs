@@ -338,6 +338,7 @@ pub fn register_icp(
         last_increment: last,
         degenerate_directions: 0,
         weakest_lever_arm_m: f64::NAN,
+        geometric_information: None,
     })
 }
 

@@ -143,6 +143,8 @@ pub(crate) struct Constrained {
     /// The weakest rotation's lever arm: `√(λ_min / N)` of the rotation
     /// block with the translation marginalised out (m).
     pub weakest_lever_arm_m: f64,
+    /// The geometric information itself (unit point noise).
+    pub information: Matrix6<f64>,
 }
 
 impl Constrained {
@@ -181,6 +183,7 @@ impl Constrained {
         Some(Self {
             basis,
             weakest_lever_arm_m: weakest.sqrt(),
+            information: *h,
         })
     }
 

@@ -68,6 +68,11 @@ pub struct Registration {
     /// initial pose (m; NaN when not computed: degeneracy handling off,
     /// CT-NDT, ICP). Near 0: a rotation the surface does not constrain.
     pub weakest_lever_arm_m: f64,
+    /// The geometric (point-to-plane) information `Σ Jᵀ n nᵀ J` at the
+    /// initial pose, for a unit point noise, when the degeneracy handling
+    /// computed it: what the surface in view constrains, unlike
+    /// `information`, which also counts NDT's pull toward cell means.
+    pub geometric_information: Option<Matrix6<f64>>,
 }
 
 impl Registration {

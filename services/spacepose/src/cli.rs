@@ -318,6 +318,11 @@ pub struct EvalTrackingArgs {
     /// paper). Default: the tracker's.
     #[arg(long)]
     pub min_lever_arm_m: Option<f64>,
+    /// Point noise (m) of the geometric measurement covariance fed to the
+    /// filter (`TrackerConfig::geometric_sigma_m`; 0 = NDT's information).
+    /// Default: the tracker's.
+    #[arg(long)]
+    pub geometric_sigma_m: Option<f64>,
     /// Write the results as JSON.
     #[arg(long)]
     pub json: Option<PathBuf>,

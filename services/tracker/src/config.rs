@@ -89,6 +89,14 @@ pub struct TrackerConfig {
     pub ndt: NdtParams,
     /// ICP parameters (Table 1).
     pub icp: IcpParams,
+    /// Point noise (m) of the geometric measurement covariance: when the
+    /// registration reports its geometric information (`ndt.min_lever_arm_m`
+    /// > 0), the filter's measurement covariance is `σ² (Σ Jᵀ n nᵀ J)⁻¹`
+    /// (lightly regularised), so a rotation the surface hardly constrains
+    /// is hardly measured, and the filter's angular velocity is not dragged
+    /// by NDT's pull toward cell means. 0: NDT's own information (the
+    /// paper's Eq. 7 Hessian).
+    pub geometric_sigma_m: f64,
     /// Relative-motion filter tuning.
     pub filter: FilterConfig,
     /// Degraded / lost thresholds.
@@ -109,6 +117,7 @@ impl Default for TrackerConfig {
                 ..NdtParams::default()
             },
             icp: IcpParams::default(),
+            geometric_sigma_m: 0.0,
             // The tracker checks consistency with absolute innovation limits
             // (`LossConfig`): the registration's information is far more
             // confident than the model errors justify, so a χ² gate on it
@@ -138,6 +147,12 @@ impl TrackerConfig {
             return Err(bad(
                 "voxel_leaf_m must be finite and > 0",
                 self.voxel_leaf_m,
+            ));
+        }
+        if !(self.geometric_sigma_m.is_finite() && self.geometric_sigma_m >= 0.0) {
+            return Err(bad(
+                "geometric_sigma_m must be finite and >= 0",
+                self.geometric_sigma_m,
             ));
         }
         self.ndt

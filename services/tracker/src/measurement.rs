@@ -12,6 +12,7 @@
 
 use nalgebra::{Matrix3, Matrix6};
 use spacepose_geometry::{Pose, so3};
+use spacepose_registration::Registration;
 
 /// The Jacobian `A = ∂ξ/∂δ` of the inversion `t_sensor_target = t_target_sensor⁻¹`
 /// for left perturbations on both sides.
@@ -39,6 +40,23 @@ pub fn covariance_sensor_target(
     let a = inversion_jacobian(t_target_sensor);
     let cov = a * cov_delta * a.transpose();
     Some((cov + cov.transpose()) * 0.5)
+}
+
+/// The information the filter's measurement covariance comes from (see
+/// `TrackerConfig::geometric_sigma_m`): the registration's geometric
+/// information over `σ²`, lightly regularised, when `geometric_sigma_m > 0`
+/// and the registration computed it; NDT's own information otherwise.
+pub fn measurement_information(r: &Registration, geometric_sigma_m: f64) -> Matrix6<f64> {
+    match r.geometric_information {
+        Some(h) if geometric_sigma_m > 0.0 => {
+            let info = h / (geometric_sigma_m * geometric_sigma_m);
+            // A direction the surface does not constrain gets a variance
+            // 1e9 times the best one's instead of an infinite one.
+            let floor = 1e-9 * info.diagonal().max().max(f64::MIN_POSITIVE);
+            info + Matrix6::identity() * floor
+        }
+        _ => r.information,
+    }
 }
 
 /// Square root of the largest eigenvalue of a 3×3 covariance block: the
@@ -83,5 +101,47 @@ mod tests {
         let mut nan = info;
         nan[(0, 0)] = f64::NAN;
         assert!(covariance_sensor_target(&t, &nan).is_none());
+    }
+
+    fn registration(geometric: Option<Matrix6<f64>>) -> Registration {
+        Registration {
+            t_target_sensor: Pose::identity(),
+            converged: true,
+            iterations: 3,
+            cost: spacepose_registration::Cost {
+                total: 1.0,
+                mean: 0.01,
+            },
+            inliers: 100,
+            valid_points: 100,
+            skipped_non_finite: 0,
+            mean_squared_distance_m2: 1e-4,
+            f_conv_m2: None,
+            information: Matrix6::identity() * 7.0,
+            last_increment: spacepose_registration::Increment::default(),
+            degenerate_directions: 1,
+            weakest_lever_arm_m: 0.0,
+            geometric_information: geometric,
+        }
+    }
+
+    #[test]
+    fn an_unconstrained_rotation_is_hardly_measured() {
+        // Geometric information with nothing about the rotation about x.
+        let mut h = Matrix6::identity() * 400.0;
+        h[(0, 0)] = 0.0;
+        let r = registration(Some(h));
+        let info = measurement_information(&r, 0.02);
+        let cov = covariance_sensor_target(&r.t_target_sensor, &info).unwrap();
+        // σ = 2 cm over 400 points-worth: 1e-3 rad on the constrained axes…
+        assert!((cov[(1, 1)].sqrt() - 1e-3).abs() < 1e-6, "{}", cov[(1, 1)]);
+        // …and a variance 1e9 times larger about x.
+        assert!(cov[(0, 0)] > 1e8 * cov[(1, 1)], "{}", cov[(0, 0)]);
+        // Off, or without geometric information: NDT's information.
+        assert_eq!(measurement_information(&r, 0.0), r.information);
+        assert_eq!(
+            measurement_information(&registration(None), 0.02),
+            Matrix6::identity() * 7.0
+        );
     }
 }

@@ -2,7 +2,7 @@
 
 use crate::config::TrackerConfig;
 use crate::error::TrackError;
-use crate::measurement::covariance_sensor_target;
+use crate::measurement::{covariance_sensor_target, measurement_information};
 use crate::mode::TrackingMode;
 use crate::model::TrackingModel;
 use crate::output::{Timings, TrackOutput};
@@ -265,8 +265,8 @@ impl Tracker {
         let innovation_rot_deg =
             so3::distance(&measured.rotation, &prediction.pose.rotation).to_degrees();
         let innovation_pos_m = (measured.translation - prediction.pose.translation).norm();
-        let covariance =
-            covariance_sensor_target(&registration.t_target_sensor, &registration.information);
+        let information = measurement_information(&registration, self.config.geometric_sigma_m);
+        let covariance = covariance_sensor_target(&registration.t_target_sensor, &information);
         let mut reasons = self.quality_issues(&registration);
         let l = &self.config.loss;
         if innovation_rot_deg > l.max_innovation_rot_deg

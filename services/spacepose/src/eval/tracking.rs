@@ -65,6 +65,8 @@ pub struct EvalConfig {
     pub warmup: usize,
     /// Overrides the tracker's NDT `min_lever_arm_m`.
     pub min_lever_arm_m: Option<f64>,
+    /// Overrides the tracker's `geometric_sigma_m`.
+    pub geometric_sigma_m: Option<f64>,
 }
 
 /// One frame of one mode.
@@ -241,6 +243,9 @@ fn start_trackers(
             let mut tracker_config = TrackerConfig::with_mode(mode);
             if let Some(lever) = config.min_lever_arm_m {
                 tracker_config.ndt.min_lever_arm_m = lever;
+            }
+            if let Some(sigma) = config.geometric_sigma_m {
+                tracker_config.geometric_sigma_m = sigma;
             }
             let mut tracker = Tracker::new(tracker_config, model.clone())?;
             tracker.initialize(t0, &pose0, Vector3::zeros(), Vector3::zeros())?;
@@ -433,6 +438,7 @@ pub fn run(args: &EvalTrackingArgs) -> Result<()> {
         target: (args.target.clone(), args.scale),
         warmup: args.warmup,
         min_lever_arm_m: args.min_lever_arm_m,
+        geometric_sigma_m: args.geometric_sigma_m,
     };
     let report = evaluate(&config)?;
     print!("{}", render(&report));
