@@ -90,12 +90,13 @@ pub struct TrackerConfig {
     /// ICP parameters (Table 1).
     pub icp: IcpParams,
     /// Point noise (m) of the geometric measurement covariance: when the
-    /// registration reports its geometric information (`ndt.min_lever_arm_m`
-    /// > 0), the filter's measurement covariance is `σ² (Σ Jᵀ n nᵀ J)⁻¹`
-    /// (lightly regularised), so a rotation the surface hardly constrains
-    /// is hardly measured, and the filter's angular velocity is not dragged
-    /// by NDT's pull toward cell means. 0: NDT's own information (the
-    /// paper's Eq. 7 Hessian).
+    /// registration reports its geometric information (with a positive
+    /// `ndt.min_lever_arm_m`), the filter's measurement covariance is
+    /// `σ² (Σ Jᵀ n nᵀ J)⁻¹` (lightly regularised), so a rotation the surface
+    /// hardly constrains is hardly measured. 0 (default): NDT's own
+    /// information (the paper's Eq. 7 Hessian). Measured on seed 11
+    /// slow-spin (deblur max 9.33 → 3.64°) and seed 7 tumbling (4.33 →
+    /// 19.8°): the filter's tuning assumes NDT's information.
     pub geometric_sigma_m: f64,
     /// Relative-motion filter tuning.
     pub filter: FilterConfig,
