@@ -16,7 +16,7 @@ use spacepose_geometry::{Euler321, Point, Pose, VoxelFilter, so3};
 use spacepose_lidar_sim::{LidarSimulator, SensorConfig};
 use spacepose_registration::{
     CellLookup, IcpModel, IcpParams, NdtMap, NdtMapParams, NdtParams, Registration, ScanTimes,
-    register_ct_ndt, register_icp, register_ndt,
+    StartPrior, register_ct_ndt, register_ct_ndt_free_start, register_icp, register_ndt,
 };
 use spacepose_scenario::TruthState;
 use spacepose_target::Target;
@@ -146,6 +146,12 @@ fn same_run_ratios(rounds: usize, jobs: &mut [Job<'_>]) {
     }
 }
 
+/// A diagonal information for standard deviations `rot_rad` and `pos_m`.
+fn start_information(rot_rad: f64, pos_m: f64) -> nalgebra::Matrix6<f64> {
+    let (a, b) = (1.0 / (rot_rad * rot_rad), 1.0 / (pos_m * pos_m));
+    nalgebra::Matrix6::from_diagonal(&nalgebra::Vector6::new(a, a, a, b, b, b))
+}
+
 fn benches(c: &mut Criterion) {
     let f = fixture();
     let map_params = NdtMapParams::default();
@@ -193,6 +199,18 @@ fn benches(c: &mut Criterion) {
         let cloud = filtered(voxel, &f.raw_blurred);
         register_ct_ndt(&map, &cloud, &f.scan, &f.truth_start, &guess_end, &grid).expect("ct")
     };
+    // The tracker's default: the start pose free under a prior (σ 0.5°,
+    // 1 cm, the order of the filter's posterior) 0.5° / 1 cm off the truth.
+    let prior = StartPrior {
+        t_target_sensor: offset(&f.truth_start, 0.5, 0.01),
+        information: start_information(0.5f64.to_radians(), 0.01),
+    };
+    let ct_free_run = |voxel: &mut VoxelFilter| {
+        let cloud = filtered(voxel, &f.raw_blurred);
+        register_ct_ndt_free_start(&map, &cloud, &f.scan, &prior, &guess_end, &grid)
+            .expect("ct free start")
+            .end
+    };
     let icp_run = |voxel: &mut VoxelFilter, p: &IcpParams| {
         let cloud = filtered(voxel, &f.raw);
         register_icp(&icp_model, &cloud, &initial, p).expect("icp")
@@ -202,6 +220,11 @@ fn benches(c: &mut Criterion) {
     let ndt_static = register_ndt(&map, &blurred, &guess_end, &grid).expect("ndt");
     report("ndt on the blurred frame", &ndt_static, &f.truth);
     report("ct_ndt/grid (end pose)", &ct_run(&mut voxel), &f.truth);
+    report(
+        "ct_ndt free start (end pose)",
+        &ct_free_run(&mut voxel),
+        &f.truth,
+    );
     let from_truth = register_ct_ndt(&map, &blurred, &f.scan, &f.truth_start, &f.truth, &grid);
     report(
         "ct_ndt/grid from the true end pose",
@@ -247,6 +270,12 @@ fn benches(c: &mut Criterion) {
                     }),
                 ),
                 (
+                    "ct_ndt free start",
+                    Box::new(|| {
+                        black_box(ct_free_run(&mut v()));
+                    }),
+                ),
+                (
                     "icp voxel+grid",
                     Box::new(|| {
                         black_box(icp_run(&mut v(), &icp));
@@ -287,6 +316,9 @@ fn benches(c: &mut Criterion) {
     let mut g = c.benchmark_group("ct_ndt");
     g.bench_function("voxel_grid_10dps_blur", |b| {
         b.iter(|| ct_run(black_box(&mut voxel)))
+    });
+    g.bench_function("free_start_voxel_grid_10dps_blur", |b| {
+        b.iter(|| ct_free_run(black_box(&mut voxel)))
     });
     g.finish();
 

@@ -13,6 +13,9 @@ use crate::source::{check_pose, position_is_finite};
 use nalgebra::{Matrix3, Matrix3x6, Vector3};
 use spacepose_geometry::{Point, Pose, so3};
 
+mod free_start;
+pub use free_start::{CtRegistration, StartPrior, register_ct_ndt_free_start};
+
 /// Start and end times of a scan on the sensor clock (s).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScanTimes {
@@ -259,28 +262,7 @@ pub fn register_ct_ndt(
         });
     }
     let skipped = source.len() - points.len();
-    // Degeneracy handling (`NdtParams::min_lever_arm_m`) on the end pose:
-    // its directions come from the rigid geometric information of the cloud
-    // placed at the initial end pose (Eq. 15 scales each point's Jacobian
-    // by its interpolation factor, which weighs the points but does not
-    // change which rotations the surface leaves free).
-    let constrained = (params.min_lever_arm_m > 0.0)
-        .then(|| {
-            let positions: Vec<Vector3<f64>> = source
-                .iter()
-                .filter(|p| position_is_finite(p) && p.t.is_finite())
-                .map(Point::position)
-                .collect();
-            let (h, n) = crate::ndt::geometric_information(
-                map,
-                &positions,
-                initial_t_target_sensor_end,
-                1,
-                params,
-            );
-            Constrained::of(&h, n, params.min_lever_arm_m)
-        })
-        .flatten();
+    let constrained = constrained_directions(map, source, initial_t_target_sensor_end, params);
     gauss_newton::run(
         *initial_t_target_sensor_end,
         params,
@@ -289,6 +271,30 @@ pub fn register_ct_ndt(
         constrained.as_ref(),
         |end, stride| linearise(map, &points, t_target_sensor_start, end, stride, params),
     )
+}
+
+/// Degeneracy handling (`NdtParams::min_lever_arm_m`) on the end pose:
+/// its directions come from the rigid geometric information of the cloud
+/// placed at the initial end pose (Eq. 15 scales each point's Jacobian by
+/// its interpolation factor, which weighs the points but does not change
+/// which rotations the surface leaves free). `None` when disabled.
+fn constrained_directions(
+    map: &NdtMap,
+    source: &[Point],
+    initial_t_target_sensor_end: &Pose,
+    params: &NdtParams,
+) -> Option<Constrained> {
+    if params.min_lever_arm_m <= 0.0 {
+        return None;
+    }
+    let positions: Vec<Vector3<f64>> = source
+        .iter()
+        .filter(|p| position_is_finite(p) && p.t.is_finite())
+        .map(Point::position)
+        .collect();
+    let (h, n) =
+        crate::ndt::geometric_information(map, &positions, initial_t_target_sensor_end, 1, params);
+    Constrained::of(&h, n, params.min_lever_arm_m)
 }
 
 #[cfg(test)]

@@ -29,7 +29,10 @@ pub mod synthetic;
 #[cfg(test)]
 mod test_support;
 
-pub use ct_ndt::{ScanTimes, ct_point_jacobian, interpolate, register_ct_ndt};
+pub use ct_ndt::{
+    CtRegistration, ScanTimes, StartPrior, ct_point_jacobian, interpolate, register_ct_ndt,
+    register_ct_ndt_free_start,
+};
 pub use error::RegistrationError;
 pub use icp::{IcpLookupStats, IcpModel, register_icp};
 pub use ndt::register_ndt;

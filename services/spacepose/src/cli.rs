@@ -323,10 +323,31 @@ pub struct EvalTrackingArgs {
     /// Default: the tracker's.
     #[arg(long)]
     pub geometric_sigma_m: Option<f64>,
+    /// Start pose of the ct-ndt scan. Default: the tracker's (filter-prior).
+    #[arg(long, value_enum)]
+    pub ct_start: Option<CtStartArg>,
     /// Write the results as JSON.
     #[arg(long)]
     pub json: Option<PathBuf>,
     /// Draw the errors over time (.png or .svg), like seed 000 Fig. 9/11.
     #[arg(long)]
     pub plot: Option<PathBuf>,
+}
+
+/// `--ct-start` values (`spacepose_tracker::CtStart`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CtStartArg {
+    /// Seed 000 Eq. (14): the start pose fixed at the previous result.
+    Fixed,
+    /// The start pose optimised too, under the filter's estimate as prior.
+    FilterPrior,
+}
+
+impl From<CtStartArg> for spacepose_tracker::CtStart {
+    fn from(a: CtStartArg) -> Self {
+        match a {
+            CtStartArg::Fixed => Self::Fixed,
+            CtStartArg::FilterPrior => Self::FilterPrior,
+        }
+    }
 }

@@ -98,10 +98,26 @@ pub struct TrackerConfig {
     /// slow-spin (deblur max 9.33 → 3.64°) and seed 7 tumbling (4.33 →
     /// 19.8°): the filter's tuning assumes NDT's information.
     pub geometric_sigma_m: f64,
+    /// Start pose of the `ct-ndt` scan (see [`CtStart`]).
+    pub ct_start: CtStart,
     /// Relative-motion filter tuning.
     pub filter: FilterConfig,
     /// Degraded / lost thresholds.
     pub loss: LossConfig,
+}
+
+/// How `ct-ndt` treats the start pose `T^s` of a scan.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CtStart {
+    /// Seed 000 Eq. (14): `T^s` fixed at the previous result.
+    Fixed,
+    /// `T^s` optimised with the end pose under a Gaussian prior: the
+    /// filter's estimate at the scan start and its covariance
+    /// (`spacepose_registration::register_ct_ndt_free_start`). An error in
+    /// the previous result no longer bends the next scan.
+    #[default]
+    FilterPrior,
 }
 
 /// Default `ndt.min_lever_arm_m` of the tracker (m); see
@@ -119,6 +135,7 @@ impl Default for TrackerConfig {
             },
             icp: IcpParams::default(),
             geometric_sigma_m: 0.0,
+            ct_start: CtStart::default(),
             // The tracker checks consistency with absolute innovation limits
             // (`LossConfig`): the registration's information is far more
             // confident than the model errors justify, so a χ² gate on it

@@ -36,6 +36,13 @@ pub enum TrackError {
     /// The filter rejected an input (non-finite pose, bad time step).
     #[error("filter failed: {0}")]
     Filter(#[from] FilterError),
+    /// The filter's covariance at a scan start is not positive definite, so
+    /// it gives `ct-ndt` no prior on the start pose.
+    #[error("no start-pose prior: the filter covariance at t = {t_s} s is not positive definite")]
+    NoStartPrior {
+        /// Scan start (s).
+        t_s: f64,
+    },
     /// The target model could not be built or loaded (unknown target, bad
     /// mesh, corrupt or unwritable NDT map file).
     #[error("tracking model: {0}")]

@@ -31,7 +31,7 @@ pub mod status;
 pub mod tracker;
 pub mod wire;
 
-pub use config::{LossConfig, TrackerConfig};
+pub use config::{CtStart, LossConfig, TrackerConfig};
 pub use error::TrackError;
 pub use mode::TrackingMode;
 pub use model::TrackingModel;

@@ -1,8 +1,8 @@
 //! The tracking loop (seed 000 Fig. 2-4).
 
-use crate::config::TrackerConfig;
+use crate::config::{CtStart, TrackerConfig};
 use crate::error::TrackError;
-use crate::measurement::{covariance_sensor_target, measurement_information};
+use crate::measurement::{covariance_sensor_target, inversion_jacobian, measurement_information};
 use crate::mode::TrackingMode;
 use crate::model::TrackingModel;
 use crate::output::{Timings, TrackOutput};
@@ -11,7 +11,8 @@ use nalgebra::Vector3;
 use spacepose_filter::{MotionCompensation, Prediction, RelativeMotionFilter};
 use spacepose_geometry::{Point, Pose, VoxelFilter, so3};
 use spacepose_registration::{
-    Registration, ScanTimes, register_ct_ndt, register_icp, register_ndt,
+    Registration, ScanTimes, StartPrior, register_ct_ndt, register_ct_ndt_free_start, register_icp,
+    register_ndt,
 };
 use std::time::Instant;
 
@@ -236,19 +237,53 @@ impl Tracker {
             TrackingMode::Icp => register_icp(self.model.icp()?, cloud, &previous, &c.icp)?,
             TrackingMode::Deblur => register_ndt(map, cloud, &predicted, &c.ndt)?,
             TrackingMode::CtNdt => {
-                // T^s is the previous result (seed 000 §3.3) carried to the
-                // scan start by the filter when scans do not abut.
-                let start = if (scan_start - last.t).abs() < 1e-9 || scan_start < last.t {
-                    previous
-                } else {
-                    self.filter.predict_at(scan_start)?.pose.inverse()
-                };
                 let scan = ScanTimes {
                     start_s: scan_start,
                     end_s: scan_end,
                 };
-                register_ct_ndt(map, cloud, &scan, &start, &predicted, &c.ndt)?
+                match c.ct_start {
+                    CtStart::Fixed => {
+                        let start = self.fixed_ct_start(last, scan_start)?;
+                        register_ct_ndt(map, cloud, &scan, &start, &predicted, &c.ndt)?
+                    }
+                    CtStart::FilterPrior => {
+                        let prior = self.ct_start_prior(scan_start)?;
+                        register_ct_ndt_free_start(map, cloud, &scan, &prior, &predicted, &c.ndt)?
+                            .end
+                    }
+                }
             }
+        })
+    }
+
+    /// `T^s` of Eq. (14): the previous result (seed 000 §3.3), carried to
+    /// the scan start by the filter when scans do not abut.
+    fn fixed_ct_start(&self, last: &LastPose, scan_start: f64) -> Result<Pose, TrackError> {
+        Ok(
+            if (scan_start - last.t).abs() < 1e-9 || scan_start < last.t {
+                last.t_sensor_target.inverse()
+            } else {
+                self.filter.predict_at(scan_start)?.pose.inverse()
+            },
+        )
+    }
+
+    /// The prior on `T^s` ([`CtStart::FilterPrior`]): the filter's estimate
+    /// at the scan start, its covariance carried through the inversion to
+    /// `t_target_sensor`. Its units are those of the registration's
+    /// information, which the filter fuses as measurement information.
+    fn ct_start_prior(&self, scan_start: f64) -> Result<StartPrior, TrackError> {
+        let at_start = self.filter.predict_at(scan_start)?;
+        let a = inversion_jacobian(&at_start.pose);
+        let cov = a * at_start.covariance * a.transpose();
+        let cov = (cov + cov.transpose()) * 0.5;
+        let information = cov
+            .cholesky()
+            .map(|c| c.inverse())
+            .ok_or(TrackError::NoStartPrior { t_s: scan_start })?;
+        Ok(StartPrior {
+            t_target_sensor: at_start.pose.inverse(),
+            information,
         })
     }
 

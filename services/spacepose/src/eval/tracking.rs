@@ -67,6 +67,8 @@ pub struct EvalConfig {
     pub min_lever_arm_m: Option<f64>,
     /// Overrides the tracker's `geometric_sigma_m`.
     pub geometric_sigma_m: Option<f64>,
+    /// Overrides the tracker's `ct_start`.
+    pub ct_start: Option<spacepose_tracker::CtStart>,
 }
 
 /// One frame of one mode.
@@ -246,6 +248,9 @@ fn start_trackers(
             }
             if let Some(sigma) = config.geometric_sigma_m {
                 tracker_config.geometric_sigma_m = sigma;
+            }
+            if let Some(start) = config.ct_start {
+                tracker_config.ct_start = start;
             }
             let mut tracker = Tracker::new(tracker_config, model.clone())?;
             tracker.initialize(t0, &pose0, Vector3::zeros(), Vector3::zeros())?;
@@ -439,6 +444,7 @@ pub fn run(args: &EvalTrackingArgs) -> Result<()> {
         warmup: args.warmup,
         min_lever_arm_m: args.min_lever_arm_m,
         geometric_sigma_m: args.geometric_sigma_m,
+        ct_start: args.ct_start.map(Into::into),
     };
     let report = evaluate(&config)?;
     print!("{}", render(&report));

@@ -1,0 +1,347 @@
+//! Continuous-time NDT with a free start pose (a departure from seed 000
+//! §3.3, measured in the tracker's README section).
+//!
+//! Eq. (14) fixes the start pose `T^s` at the previous result, so an error
+//! there moves the early points of the scan for good: they fall outside the
+//! 7.5 cm association distance, the end pose bends to fit the rest, and the
+//! next scan starts from that. On sparse frames (1-3k points, MLI faces
+//! invisible) this fed on itself until track was lost.
+//!
+//! Here `T^s` and `T^e` are optimised together; `T^s` is held by a Gaussian
+//! prior (mean and information, typically the filter's estimate at the scan
+//! start), the Maximum-a-posteriori form of the paper's constraint: an
+//! infinite prior information gives back Eq. (14). The Jacobian with
+//! respect to `T^s` is Eq. (15) with the ends swapped, since
+//! `interp(T^s, T^e, u) = interp(T^e, T^s, 1 - u)`.
+//!
+//! The reported information is that of `T^e` with `T^s` marginalised out
+//! (Schur complement), the reported cost that of the points alone.
+
+use super::{Interpolation, ScanTimes, constrained_directions};
+use crate::error::RegistrationError;
+use crate::ndt_map::NdtMap;
+use crate::normal_equations::{Constrained, increment_of};
+use crate::params::NdtParams;
+use crate::result::{Cost, Increment, Registration};
+use crate::source::{check_pose, position_is_finite};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, SMatrix, SVector, Vector3, Vector6};
+use spacepose_geometry::{Point, Pose, so3};
+
+type Matrix12 = SMatrix<f64, 12, 12>;
+type Vector12 = SVector<f64, 12>;
+type Matrix3x12 = SMatrix<f64, 3, 12>;
+
+/// A Gaussian prior on the start pose `T^s = t_target_sensor` of a scan.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StartPrior {
+    /// Mean of `T^s`.
+    pub t_target_sensor: Pose,
+    /// Information (inverse covariance) of a left perturbation
+    /// `δ = [rot; trans]` of the mean (seed 000 Eq. 5); symmetric positive
+    /// semi-definite, in the units of the NDT information (Eq. 7).
+    pub information: Matrix6<f64>,
+}
+
+impl StartPrior {
+    /// Rejects a non-finite mean or information, or a negative diagonal.
+    pub fn validate(&self) -> Result<(), RegistrationError> {
+        check_pose("start prior", &self.t_target_sensor)?;
+        let ok = self.information.iter().all(|v| v.is_finite())
+            && self.information.diagonal().iter().all(|&d| d >= 0.0);
+        if ok {
+            Ok(())
+        } else {
+            Err(RegistrationError::param(
+                "start_prior.information",
+                "need a finite matrix with a non-negative diagonal",
+            ))
+        }
+    }
+}
+
+/// The outcome of [`register_ct_ndt_free_start`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct CtRegistration {
+    /// The end pose `T^e` with its quality figures; `information` is that
+    /// of `T^e` with `T^s` marginalised out.
+    pub end: Registration,
+    /// The estimated start pose `T^s`.
+    pub t_target_sensor_start: Pose,
+    /// How far `T^s` moved from the prior mean.
+    pub start_correction: Increment,
+}
+
+/// `Σ JᵀPJ`, `Σ JᵀPr`, `Σ rᵀPr`, `Σ |r|²` over the inliers for the stacked
+/// perturbation `[δ^s; δ^e]`.
+struct Joint {
+    h: Matrix12,
+    g: Vector12,
+    cost: f64,
+    squared_distance: f64,
+    inliers: usize,
+}
+
+impl Joint {
+    fn new() -> Self {
+        Self {
+            h: Matrix12::zeros(),
+            g: Vector12::zeros(),
+            cost: 0.0,
+            squared_distance: 0.0,
+            inliers: 0,
+        }
+    }
+
+    fn add(&mut self, j: &Matrix3x12, p: &Matrix3<f64>, r: &Vector3<f64>) {
+        let pj = p * j;
+        let pr = p * r;
+        self.h += j.tr_mul(&pj);
+        self.g += j.tr_mul(&pr);
+        self.cost += r.dot(&pr);
+        self.squared_distance += r.norm_squared();
+        self.inliers += 1;
+    }
+
+    /// Adds the prior `½ eᵀ Ω e` with `e = T^s ⊖ T^s₀`; `∂e/∂δ^s` is
+    /// `blockdiag(J_l⁻¹(e_rot), I)` (left perturbation of `Log`).
+    fn add_prior(&mut self, start: &Pose, prior: &StartPrior) {
+        let e = start.ominus(&prior.t_target_sensor);
+        let mut jp = Matrix6::identity();
+        let e_rot = Vector3::new(e[0], e[1], e[2]);
+        jp.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&so3::d_exp_inv(&e_rot));
+        let omega_jp = prior.information * jp;
+        let h_ss = jp.tr_mul(&omega_jp);
+        let g_s = jp.tr_mul(&(prior.information * e));
+        let mut hv = self.h.fixed_view_mut::<6, 6>(0, 0);
+        hv += h_ss;
+        let mut gv = self.g.fixed_rows_mut::<6>(0);
+        gv += g_s;
+    }
+
+    /// The information of `T^e` with `T^s` marginalised out.
+    fn end_information(&self) -> Matrix6<f64> {
+        let h_ss = self.h.fixed_view::<6, 6>(0, 0).into_owned();
+        let h_se = self.h.fixed_view::<6, 6>(0, 6).into_owned();
+        let h_ee = self.h.fixed_view::<6, 6>(6, 6).into_owned();
+        match h_ss.cholesky() {
+            Some(c) => {
+                let m = h_ee - h_se.transpose() * c.solve(&h_se);
+                (m + m.transpose()) * 0.5
+            }
+            None => h_ee,
+        }
+    }
+
+    /// Solves `H ε = -g` in `span(basis)` (all 12 directions when `None`).
+    fn solve(&self, basis: Option<&DMatrix<f64>>) -> Option<Vector12> {
+        let eps = match basis {
+            None => {
+                let scale = self.h.diagonal().max();
+                if !(scale.is_finite() && scale > 0.0) {
+                    return None;
+                }
+                let chol = self.h.cholesky()?;
+                let l = chol.l_dirty();
+                if (0..12).any(|i| l[(i, i)] * l[(i, i)] <= 1e-12 * scale) {
+                    return None;
+                }
+                -chol.solve(&self.g)
+            }
+            Some(q) => {
+                let h = DMatrix::from_fn(12, 12, |i, j| self.h[(i, j)]);
+                let g = DVector::from_fn(12, |i, _| self.g[i]);
+                let y = (q.transpose() * &h * q)
+                    .cholesky()?
+                    .solve(&(q.transpose() * g));
+                let eps = -(q * y);
+                Vector12::from_iterator(eps.iter().copied())
+            }
+        };
+        eps.iter().all(|v| v.is_finite()).then_some(eps)
+    }
+}
+
+/// Normal equations at `(start, end)` over every `stride`-th point `z`
+/// with interpolation factor `u`.
+fn linearise(
+    map: &NdtMap,
+    points: &[(Vector3<f64>, f64)],
+    start: &Pose,
+    end: &Pose,
+    stride: usize,
+    params: &NdtParams,
+) -> Joint {
+    let forward = Interpolation::new(start, end);
+    let backward = Interpolation::new(end, start);
+    let mut joint = Joint::new();
+    let mut j = Matrix3x12::zeros();
+    for (z, u) in points.iter().step_by(stride.max(1)) {
+        let le = forward.apply(&(start.rotation * z), *u);
+        let Some((k, _)) = map.nearest_cell(&le.point, params.max_distance_m, params.lookup) else {
+            continue;
+        };
+        let ls = backward.apply(&(end.rotation * z), 1.0 - *u);
+        j.fixed_view_mut::<3, 3>(0, 0).copy_from(&ls.j_r);
+        j.fixed_view_mut::<3, 3>(0, 3).copy_from(&ls.j_t);
+        j.fixed_view_mut::<3, 3>(0, 6).copy_from(&le.j_r);
+        j.fixed_view_mut::<3, 3>(0, 9).copy_from(&le.j_t);
+        let (mean, information) = map.mean_and_information(k);
+        joint.add(&j, information, &(le.point - mean));
+    }
+    joint
+}
+
+fn split(eps: &Vector12) -> (Vector6<f64>, Vector6<f64>) {
+    (
+        eps.fixed_rows::<6>(0).into_owned(),
+        eps.fixed_rows::<6>(6).into_owned(),
+    )
+}
+
+/// Continuous-time NDT with the start pose free under `prior` (see the
+/// module documentation). Same termination as [`crate::register_ndt`],
+/// applied to both poses' increments; same errors as
+/// [`super::register_ct_ndt`], plus an invalid prior.
+pub fn register_ct_ndt_free_start(
+    map: &NdtMap,
+    source: &[Point],
+    scan: &ScanTimes,
+    prior: &StartPrior,
+    initial_t_target_sensor_end: &Pose,
+    params: &NdtParams,
+) -> Result<CtRegistration, RegistrationError> {
+    params.validate()?;
+    scan.validate()?;
+    prior.validate()?;
+    check_pose("initial_t_target_sensor_end", initial_t_target_sensor_end)?;
+    if source.is_empty() {
+        return Err(RegistrationError::EmptyCloud);
+    }
+    let points: Vec<(Vector3<f64>, f64)> = source
+        .iter()
+        .filter(|p| position_is_finite(p) && p.t.is_finite())
+        .map(|p| (p.position(), scan.factor(p.t)))
+        .collect();
+    if points.is_empty() {
+        return Err(RegistrationError::AllPointsNonFinite {
+            count: source.len(),
+        });
+    }
+    let skipped = source.len() - points.len();
+    let constrained = constrained_directions(map, source, initial_t_target_sensor_end, params);
+    let basis = constrained.as_ref().and_then(stacked_basis);
+    let degenerate =
+        |iteration, inliers| RegistrationError::DegenerateSystem { iteration, inliers };
+    let no_match = |iteration| RegistrationError::NoCorrespondences {
+        iteration,
+        max_distance_m: params.max_distance_m,
+    };
+    let rot_tol = params.termination_rotation_deg.to_radians();
+    let below = |inc: &Increment, factor: f64| {
+        inc.rotation_rad < rot_tol * factor
+            && inc.translation_m < params.termination_translation_m * factor
+    };
+    let (mut start, mut end) = (prior.t_target_sensor, *initial_t_target_sensor_end);
+    let mut stride = params.coarse_stride.max(1);
+    let (mut iterations, mut last) = (0, Increment::default());
+    let mut final_joint = None;
+    for it in 0..params.max_iterations {
+        let mut joint = linearise(map, &points, &start, &end, stride, params);
+        if joint.inliers < 12 && stride > 1 {
+            stride = 1;
+            joint = linearise(map, &points, &start, &end, stride, params);
+        }
+        if joint.inliers == 0 {
+            return Err(no_match(it));
+        }
+        let data_only = (joint.cost, joint.squared_distance);
+        if stride > 1 {
+            // The prior must weigh against the same number of points.
+            let s = stride as f64;
+            joint.h *= s;
+            joint.g *= s;
+        }
+        joint.add_prior(&start, prior);
+        let eps = joint
+            .solve(basis.as_ref())
+            .ok_or_else(|| degenerate(it, joint.inliers))?;
+        (joint.cost, joint.squared_distance) = data_only;
+        let (eps_s, eps_e) = split(&eps);
+        start = start.oplus(&eps_s);
+        end = end.oplus(&eps_e);
+        iterations = it + 1;
+        let (inc_s, inc_e) = (increment_of(&eps_s), increment_of(&eps_e));
+        last = inc_e;
+        let both_below = |f| below(&inc_s, f) && below(&inc_e, f);
+        if stride == 1 && both_below(1.0) {
+            final_joint = Some(joint);
+            break;
+        }
+        if stride > 1 && both_below(params.coarse_switch) {
+            stride = 1;
+        }
+    }
+    let converged = final_joint.is_some();
+    let joint = match final_joint {
+        Some(j) => j,
+        None => {
+            let mut j = linearise(map, &points, &start, &end, 1, params);
+            let data_only = (j.cost, j.squared_distance);
+            j.add_prior(&start, prior);
+            (j.cost, j.squared_distance) = data_only;
+            j
+        }
+    };
+    if joint.inliers == 0 {
+        return Err(no_match(iterations));
+    }
+    let n = joint.inliers as f64;
+    let end_registration = Registration {
+        t_target_sensor: end,
+        converged,
+        iterations,
+        cost: Cost {
+            total: joint.cost,
+            mean: joint.cost / n,
+        },
+        inliers: joint.inliers,
+        valid_points: points.len(),
+        skipped_non_finite: skipped,
+        mean_squared_distance_m2: joint.squared_distance / n,
+        f_conv_m2: None,
+        information: joint.end_information(),
+        last_increment: last,
+        degenerate_directions: constrained.as_ref().map_or(0, Constrained::dropped),
+        weakest_lever_arm_m: constrained
+            .as_ref()
+            .map_or(f64::NAN, |c| c.weakest_lever_arm_m),
+        geometric_information: constrained.map(|c| c.information),
+    };
+    Ok(CtRegistration {
+        end: end_registration,
+        t_target_sensor_start: start,
+        start_correction: increment_of(&start.ominus(&prior.t_target_sensor)),
+    })
+}
+
+/// `blockdiag(Q, Q)` for a restricted basis `Q` (the same rotations are
+/// held at both ends); `None` when nothing is held.
+fn stacked_basis(c: &Constrained) -> Option<DMatrix<f64>> {
+    let k = c.basis.len();
+    if k == 6 {
+        return None;
+    }
+    let mut q = DMatrix::zeros(12, 2 * k);
+    for (j, b) in c.basis.iter().enumerate() {
+        for i in 0..6 {
+            q[(i, j)] = b[i];
+            q[(i + 6, j + k)] = b[i];
+        }
+    }
+    Some(q)
+}
+
+#[cfg(test)]
+#[path = "free_start_tests.rs"]
+mod tests;
