@@ -28,6 +28,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "fast" => c.fast = v.parse()?,
             "trim" => c.trimmed_centroid = v.parse()?,
             "cands" => c.icp_candidates = v.parse()?,
+            "screen" => c.screen_candidates = v.parse()?,
+            "screen_iters" => c.screen_iterations = v.parse()?,
+            "budget" => c.screen_point_budget = v.parse()?,
             "stride" => c.template_stride = v.parse()?,
             "coarse" => {
                 let (s, n) = v.split_once(':').ok_or("coarse=stride:keep")?;

@@ -24,6 +24,6 @@ pub use error::AcquisitionError;
 pub use grid::euler_grid;
 pub use matcher::TemplateMatcher;
 pub use outcome::AcquisitionOutcome;
-pub use refine::{Refined, refine};
+pub use refine::{Refined, refine, refine_with_stages, screen};
 pub use spacepose_registration::IcpParams;
 pub use template::{TemplateRenderer, template_directions};

@@ -6,7 +6,7 @@ use crate::correlation::{Centering, Correlator, d_bor, d_bor_passes};
 use crate::error::AcquisitionError;
 use crate::grid::euler_grid;
 use crate::outcome::AcquisitionOutcome;
-use crate::refine::{Refined, refine};
+use crate::refine::{Refined, refine_with_stages, screen};
 use crate::template::TemplateRenderer;
 use nalgebra::{Rotation3, Vector3};
 use rayon::prelude::*;
@@ -196,7 +196,12 @@ impl TemplateMatcher {
             d_bor: d_bor(&positions),
         };
         let (ranked, generated, rejected) = self.match_templates(&sensed);
-        let evaluated = ranked.len();
+        // Correlations computed at full resolution (the fine pass only,
+        // with coarse-to-fine).
+        let evaluated = match self.config.coarse_to_fine {
+            Some(c) if self.coarse_renderer.is_some() => ranked.len().min(c.keep),
+            _ => ranked.len(),
+        };
         let Some(&(_, best_c, _)) = ranked.first() else {
             return Err(AcquisitionError::NoTemplate {
                 generated,
@@ -206,21 +211,25 @@ impl TemplateMatcher {
         let matching_ms = ms_since(start);
 
         // Template solution(s): grid attitude, origin from the centroid alignment.
-        let candidates: Vec<(usize, Pose)> = self
-            .distinct_candidates(&ranked)
-            .into_iter()
-            .map(|(k, origin)| (k, Pose::new(self.grid[k].1, origin)))
-            .collect();
         let refine_start = Instant::now();
-        let refined: Vec<Result<Refined, String>> = candidates
+        let (candidates, starts, screened) = self.screened_candidates(&ranked, &finite);
+        // After screening, the wide stages have been run: only the
+        // narrowest is repeated, on the full model, before the final one.
+        let stages = &self.config.icp_stages_m;
+        let stages = match screened {
+            0 => &stages[..],
+            _ => &stages[stages.len().saturating_sub(1)..],
+        };
+        let refined: Vec<Result<Refined, String>> = starts
             .iter()
-            .map(|(_, pose)| {
-                refine(
+            .map(|pose| {
+                refine_with_stages(
                     &self.icp_model,
                     self.stage_model(),
                     &finite,
                     pose,
                     &self.config,
+                    stages,
                 )
                 .map_err(|e| e.to_string())
             })
@@ -275,6 +284,7 @@ impl TemplateMatcher {
             matching_ms,
             refinement_ms,
             candidates_refined: candidates.len(),
+            candidates_screened: screened,
             chosen_rank,
             icp_iterations: iterations,
             icp_converged: converged,
@@ -283,16 +293,65 @@ impl TemplateMatcher {
         })
     }
 
-    /// The `icp_candidates` best templates, skipping any closer than
+    /// The candidates to refine, `(grid index, template pose)`, the poses
+    /// their refinement starts from, and how many were screened: the
+    /// `icp_candidates` best distinct templates, or with screening the
+    /// `icp_candidates` best after the short ICP, from where it left them.
+    fn screened_candidates(
+        &self,
+        ranked: &[(usize, f64, Vector3<f64>)],
+        cloud: &[Point],
+    ) -> (Vec<(usize, Pose)>, Vec<Pose>, usize) {
+        let c = &self.config;
+        let keep = c.icp_candidates;
+        let mut count = keep.max(c.screen_candidates);
+        if c.screen_point_budget > 0 {
+            count = count.min((c.screen_point_budget / cloud.len().max(1)).max(keep));
+        }
+        let templates: Vec<(usize, Pose)> = self
+            .distinct_candidates(ranked, count)
+            .into_iter()
+            .map(|(k, origin)| (k, Pose::new(self.grid[k].1, origin)))
+            .collect();
+        let unscreened = |t: Vec<(usize, Pose)>| {
+            let t: Vec<(usize, Pose)> = t.into_iter().take(keep).collect();
+            let starts = t.iter().map(|c| c.1).collect();
+            (t, starts, 0)
+        };
+        if templates.len() <= keep {
+            return unscreened(templates);
+        }
+        let mut screened: Vec<(f64, usize, Pose)> = templates
+            .iter()
+            .enumerate()
+            .filter_map(|(i, (_, pose))| {
+                screen(self.stage_model(), cloud, pose, c)
+                    .ok()
+                    .map(|(p, score)| (score, i, p))
+            })
+            .collect();
+        if screened.is_empty() {
+            // Every short ICP failed: refine the best templates unscreened.
+            return unscreened(templates);
+        }
+        screened.sort_by(|a, b| a.0.total_cmp(&b.0));
+        screened.truncate(keep);
+        let chosen = screened.iter().map(|&(_, i, _)| templates[i]).collect();
+        let starts = screened.iter().map(|&(_, _, p)| p).collect();
+        (chosen, starts, templates.len())
+    }
+
+    /// The `count` best templates, skipping any closer than
     /// `candidate_separation_deg` to a better one: `(grid index, origin)`.
     fn distinct_candidates(
         &self,
         ranked: &[(usize, f64, Vector3<f64>)],
+        count: usize,
     ) -> Vec<(usize, Vector3<f64>)> {
         let min_sep = self.config.candidate_separation_deg.to_radians();
         let mut chosen: Vec<(usize, Vector3<f64>)> = Vec::new();
         for &(k, _, centre) in ranked {
-            if chosen.len() == self.config.icp_candidates {
+            if chosen.len() == count {
                 break;
             }
             let r = &self.grid[k].1;
@@ -330,7 +389,11 @@ impl TemplateMatcher {
                 .collect();
             let scores = self.score(&kept, &self.renderer, sensed, false);
             generated += scores.len();
+            let coarse_rest = ranked.split_off(keep.min(ranked.len()));
             ranked = rank(&scores);
+            // Candidate screening may reach beyond the fine pass: the other
+            // templates follow in their coarse order.
+            ranked.extend(coarse_rest);
         }
         (ranked, generated, rejected)
     }

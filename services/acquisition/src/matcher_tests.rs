@@ -174,3 +174,41 @@ fn single_thread_and_parallel_agree() {
     assert_eq!(a, b);
     assert!(a.2 > 0 && a.0.len() + a.2 == 605);
 }
+
+/// Candidate screening (`screen_candidates`, `screen_point_budget`): the
+/// number screened follows the budget, and the pose is still recovered.
+#[test]
+fn screening_follows_its_budget_and_recovers_the_pose() {
+    let r = Euler321::from_degrees(-100.0, 35.0, 70.0).to_rotation();
+    let truth = Pose::new(r, Vector3::new(-0.4, 0.3, 30.0));
+    let cloud = frame(truth, Effects::none(), 2);
+    let points = cloud.len();
+    let config = |budget| TemplateMatchingConfig {
+        icp_candidates: 2,
+        screen_candidates: 40,
+        screen_point_budget: budget,
+        threads: Threads::Single,
+        ..TemplateMatchingConfig::default()
+    };
+    let m = TemplateMatcher::new(envisat(), SensorConfig::raster_seed002(), config(0)).unwrap();
+    let out = m.acquire(&cloud).unwrap();
+    // No budget: the cap (fewer when fewer distinct templates exist).
+    assert!(out.candidates_screened > 2 && out.candidates_screened <= 40);
+    assert_eq!(out.candidates_refined, 2);
+    let err_deg = so3::distance(&out.t_sensor_target.rotation, &r).to_degrees();
+    assert!(err_deg < 3.0 && out.accepted, "{err_deg} deg {out:?}");
+    // A budget of 10 clouds screens 10 candidates.
+    let m = TemplateMatcher::new(
+        envisat(),
+        SensorConfig::raster_seed002(),
+        config(10 * points),
+    )
+    .unwrap();
+    let out = m.acquire(&cloud).unwrap();
+    assert_eq!(out.candidates_screened, 10);
+    // A budget below `icp_candidates` clouds: no screening.
+    let m =
+        TemplateMatcher::new(envisat(), SensorConfig::raster_seed002(), config(points)).unwrap();
+    let out = m.acquire(&cloud).unwrap();
+    assert_eq!((out.candidates_screened, out.candidates_refined), (0, 2));
+}

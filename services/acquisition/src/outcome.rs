@@ -42,7 +42,11 @@ pub struct AcquisitionOutcome {
     pub refinement_ms: f64,
     /// Candidates refined by ICP.
     pub candidates_refined: usize,
-    /// Rank (by C, 0 = best) of the candidate whose refinement won.
+    /// Candidates screened by a short ICP before the refinement (0 when
+    /// screening is off).
+    pub candidates_screened: usize,
+    /// Rank (0 = best) of the candidate whose refinement won: by C, or
+    /// with screening by the screening score.
     pub chosen_rank: usize,
     /// ICP iterations of the winning refinement (all stages).
     pub icp_iterations: usize,

@@ -30,9 +30,29 @@ pub fn refine(
     t_sensor_target: &Pose,
     config: &TemplateMatchingConfig,
 ) -> Result<Refined, RegistrationError> {
+    refine_with_stages(
+        model,
+        stage_model,
+        cloud,
+        t_sensor_target,
+        config,
+        &config.icp_stages_m,
+    )
+}
+
+/// [`refine`] with the wide stages `stages_m` instead of
+/// `config.icp_stages_m` (e.g. only the narrowest after [`screen`]).
+pub fn refine_with_stages(
+    model: &IcpModel,
+    stage_model: &IcpModel,
+    cloud: &[Point],
+    t_sensor_target: &Pose,
+    config: &TemplateMatchingConfig,
+    stages_m: &[f64],
+) -> Result<Refined, RegistrationError> {
     let mut t_target_sensor = t_sensor_target.inverse();
     let mut iterations = 0;
-    for &d in &config.icp_stages_m {
+    for &d in stages_m {
         let params = IcpParams {
             max_distance_m: d,
             max_iterations: config.icp_stage_iterations,
@@ -60,6 +80,37 @@ pub fn refine(
         converged: r.converged,
         inlier_fraction: r.inlier_fraction(),
     })
+}
+
+/// A short ICP from a template pose to rank candidates (see
+/// [`TemplateMatchingConfig::screen_candidates`]): the wide stages and a
+/// final one at `2 · icp.max_distance_m`, `screen_iterations` each, all on
+/// `stage_model`. Returns the pose reached and its truncated f_CONV at that
+/// final distance (lower is better).
+pub fn screen(
+    stage_model: &IcpModel,
+    cloud: &[Point],
+    t_sensor_target: &Pose,
+    config: &TemplateMatchingConfig,
+) -> Result<(Pose, f64), RegistrationError> {
+    let final_m = 2.0 * config.icp.max_distance_m;
+    let mut t_target_sensor = t_sensor_target.inverse();
+    let mut last = None;
+    for &d in config.icp_stages_m.iter().chain(std::iter::once(&final_m)) {
+        let params = IcpParams {
+            max_distance_m: d,
+            max_iterations: config.screen_iterations,
+            termination_increment: config.icp.termination_increment.max(1e-4),
+            ..config.icp
+        };
+        let r = register_icp(stage_model, cloud, &t_target_sensor, &params)?;
+        t_target_sensor = r.t_target_sensor;
+        last = Some(r);
+    }
+    let score = last.map_or(f64::INFINITY, |r| {
+        truncated_f_conv(r.inlier_fraction(), r.mean_squared_distance_m2, final_m)
+    });
+    Ok((t_target_sensor.inverse(), score))
 }
 
 /// Truncated f_CONV (departure from seed 002 §4.5, see

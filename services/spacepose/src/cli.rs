@@ -323,6 +323,12 @@ pub struct EvalTrackingArgs {
     /// Default: the tracker's.
     #[arg(long)]
     pub geometric_sigma_m: Option<f64>,
+    /// Tracker configuration (TOML, the `[tracker]` table's fields of a
+    /// tracker service config, i.e. `TrackerConfig`) to start from instead
+    /// of the defaults; the mode is set per evaluated mode and the flags
+    /// below override it.
+    #[arg(long)]
+    pub tracker_config: Option<PathBuf>,
     /// Start pose of the ct-ndt scan. Default: the tracker's (filter-prior).
     #[arg(long, value_enum)]
     pub ct_start: Option<CtStartArg>,

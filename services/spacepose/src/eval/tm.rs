@@ -65,9 +65,18 @@ pub struct TmOptions {
     /// Position from the trimmed centroid (seed 004) instead of the mean.
     #[arg(long)]
     pub trimmed: bool,
-    /// Best templates refined by ICP, lowest f_CONV kept (1 = seed 002).
-    #[arg(long, default_value_t = 4)]
-    pub icp_candidates: usize,
+    /// Candidates refined fully by ICP, lowest f_CONV kept (1 with
+    /// `--screen-candidates 0` = seed 002). Default: the library's (2).
+    #[arg(long)]
+    pub icp_candidates: Option<usize>,
+    /// Distinct templates screened by a short ICP before the refinement
+    /// (0 = off). Default: the library's (100).
+    #[arg(long)]
+    pub screen_candidates: Option<usize>,
+    /// Screening work budget in cloud points (candidates ≤ budget /
+    /// points; 0 = no budget). Default: the library's (5000).
+    #[arg(long)]
+    pub screen_budget: Option<usize>,
     /// Ray thinning of every template (1 = every sensor ray).
     #[arg(long, default_value_t = 1)]
     pub template_stride: usize,
@@ -122,7 +131,9 @@ impl TmOptions {
                 Threads::All
             },
             f_max_m2: self.f_max.unwrap_or(d.f_max_m2),
-            icp_candidates: self.icp_candidates,
+            icp_candidates: self.icp_candidates.unwrap_or(d.icp_candidates),
+            screen_candidates: self.screen_candidates.unwrap_or(d.screen_candidates),
+            screen_point_budget: self.screen_budget.unwrap_or(d.screen_point_budget),
             template_stride: self.template_stride,
             coarse_to_fine: (self.coarse_stride > 0).then_some(CoarseToFine {
                 stride: self.coarse_stride,
@@ -415,7 +426,7 @@ fn summarise(
 pub fn render(report: &TmReport, with_frames: bool) -> String {
     let c = &report.config;
     let mut out = format!(
-        "template matching: {} / {}{} / seed {} / {} frames / Δ {}° {}/ {} / {} ICP candidate(s), mean {:.0} points\n",
+        "template matching: {} / {}{} / seed {} / {} frames / Δ {}° {}/ {} / {}{} refined, mean {:.0} points\n",
         report.target,
         report.scenario,
         if report.range_m.is_finite() {
@@ -435,6 +446,14 @@ pub fn render(report: &TmReport, with_frames: bool) -> String {
             "1 thread"
         } else {
             "all threads"
+        },
+        if c.screen_candidates > c.icp_candidates {
+            format!(
+                "≤ {} screened (budget {} points), ",
+                c.screen_candidates, c.screen_point_budget
+            )
+        } else {
+            String::new()
         },
         c.icp_candidates,
         report.mean_points,

@@ -69,6 +69,8 @@ pub struct EvalConfig {
     pub geometric_sigma_m: Option<f64>,
     /// Overrides the tracker's `ct_start`.
     pub ct_start: Option<spacepose_tracker::CtStart>,
+    /// Base tracker configuration (the defaults when `None`).
+    pub tracker: Option<TrackerConfig>,
 }
 
 /// One frame of one mode.
@@ -86,6 +88,12 @@ pub struct FrameRecord {
     pub ang_err_deg: f64,
     /// Position error (cm); NaN when lost.
     pub pos_err_cm: f64,
+    /// Error of the filter's angular velocity after this frame, `|ω̂ − ω|`
+    /// in the target frame (deg/s).
+    pub w_err_deg_s: f64,
+    /// Its component along the true ω (deg/s; for a spinning target, the
+    /// spin-rate error that drifts an unobservable roll).
+    pub w_err_along_deg_s: f64,
     /// Processing time, voxel filter included (ms).
     pub time_ms: f64,
     /// Registration iterations.
@@ -242,7 +250,10 @@ fn start_trackers(
         .modes
         .iter()
         .map(|&mode| {
-            let mut tracker_config = TrackerConfig::with_mode(mode);
+            let mut tracker_config = TrackerConfig {
+                mode,
+                ..config.tracker.clone().unwrap_or_default()
+            };
             if let Some(lever) = config.min_lever_arm_m {
                 tracker_config.ndt.min_lever_arm_m = lever;
             }
@@ -284,6 +295,7 @@ fn track_frame(tracker: &mut Tracker, frame: &Frame, index: usize) -> Result<Fra
         .with_context(|| format!("frame {index}"))?;
     let has_pose = out.status != TrackStatus::Lost;
     let (ang, pos) = out.t_sensor_target.error_to(&frame.truth.t_sensor_target);
+    let w_err = out.w_target - frame.truth.w_target;
     Ok(FrameRecord {
         frame: index,
         t: frame.scan_end,
@@ -291,6 +303,16 @@ fn track_frame(tracker: &mut Tracker, frame: &Frame, index: usize) -> Result<Fra
         status: out.status,
         ang_err_deg: if has_pose { ang.to_degrees() } else { f64::NAN },
         pos_err_cm: if has_pose { pos * 100.0 } else { f64::NAN },
+        w_err_deg_s: w_err.norm().to_degrees(),
+        w_err_along_deg_s: w_err
+            .dot(
+                &frame
+                    .truth
+                    .w_target
+                    .try_normalize(1e-12)
+                    .unwrap_or_default(),
+            )
+            .to_degrees(),
         time_ms: out.timings.total_ms,
         iterations: out.iterations(),
         cost_mean: out.registration.as_ref().map_or(f64::NAN, |r| r.cost.mean),
@@ -445,6 +467,11 @@ pub fn run(args: &EvalTrackingArgs) -> Result<()> {
         min_lever_arm_m: args.min_lever_arm_m,
         geometric_sigma_m: args.geometric_sigma_m,
         ct_start: args.ct_start.map(Into::into),
+        tracker: args
+            .tracker_config
+            .as_deref()
+            .map(load_tracker_config)
+            .transpose()?,
     };
     let report = evaluate(&config)?;
     print!("{}", render(&report));
@@ -487,4 +514,16 @@ fn write_json(path: &PathBuf, report: &TrackingReport) -> Result<()> {
     std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
     println!("results written to {}", path.display());
     Ok(())
+}
+
+/// Reads a `TrackerConfig` from a TOML file.
+fn load_tracker_config(path: &std::path::Path) -> Result<TrackerConfig> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading tracker config {}", path.display()))?;
+    let config: TrackerConfig =
+        toml::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+    config
+        .validate()
+        .with_context(|| format!("validating {}", path.display()))?;
+    Ok(config)
 }
