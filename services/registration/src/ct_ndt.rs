@@ -150,15 +150,35 @@ impl Interpolation {
     /// vector.
     #[inline]
     fn apply(&self, w: &Vector3<f64>, u: f64) -> Linearised {
+        let phi2 = self.phi.norm_squared();
+        let v = u - 1.0;
+        self.apply_with(
+            w,
+            u,
+            exp_coefficients(phi2 * u * u),
+            exp_coefficients(phi2 * v * v),
+        )
+    }
+
+    /// [`Interpolation::apply`] with the coefficients of
+    /// [`exp_coefficients`] at `|φ|² u²` and `|φ|² (u-1)²` given (the
+    /// free-start CT-NDT shares them between both ends, whose factors are
+    /// `u` and `1 - u`).
+    #[inline]
+    fn apply_with(
+        &self,
+        w: &Vector3<f64>,
+        u: f64,
+        (a, b, c): (f64, f64, f64),
+        (a2, b2, _): (f64, f64, f64),
+    ) -> Linearised {
         let x = self.phi * u;
-        let (a, b, c) = exp_coefficients(x.norm_squared());
         let y = w - (self.q_start * (1.0 - u) + self.q_end * u);
         let xy = x.cross(&y);
         let point = y + xy * a + x.cross(&xy) * b;
         let d = self.l0 + self.l1 * (b * u) + self.l2 * (c * u * u);
         // Exp((u-1)φ) = I + a' (u-1) φ^× + b' (u-1)² (φ^×)².
         let v = u - 1.0;
-        let (a2, b2, _) = exp_coefficients(self.phi.norm_squared() * v * v);
         let (s1, s2) = (a2 * v, b2 * v * v);
         let m = Matrix3::identity() + self.k1 * s1 + self.k2 * s2;
         let m_p = self.p0 + self.p1 * s1 + self.p2 * s2;

@@ -87,11 +87,13 @@ fn every_mode_tracks_the_slow_spin_inspection() {
 #[test]
 fn deblur_and_ct_ndt_track_a_10_degps_tumble() {
     let modes = [TrackingMode::Deblur, TrackingMode::CtNdt];
-    let results = run(ScenarioKind::Tumbling, &modes, 0, 16, 12);
+    let results = run(ScenarioKind::Tumbling, &modes, 0, 20, 12);
     for (mode, res) in modes.iter().zip(&results) {
         for (k, (status, ang, pos)) in res.iter().enumerate() {
             assert_ne!(*status, TrackStatus::Lost, "{mode} frame {k}");
-            let limit = if k < 6 { 10.0 } else { 3.0 };
+            // The filter starts at ω = 0 and learns the 10°/s within the
+            // evaluation's 10 warm-up frames (seed 000 §5.2).
+            let limit = if k < 10 { 10.0 } else { 3.0 };
             assert!(
                 *ang < limit && *pos < 0.1,
                 "{mode} frame {k}: {ang:.2} deg, {pos:.3} m"

@@ -11,8 +11,8 @@ use nalgebra::Vector3;
 use spacepose_filter::{MotionCompensation, Prediction, RelativeMotionFilter};
 use spacepose_geometry::{Point, Pose, VoxelFilter, so3};
 use spacepose_registration::{
-    Registration, ScanTimes, StartPrior, register_ct_ndt, register_ct_ndt_free_start, register_icp,
-    register_ndt,
+    NdtParams, Registration, ScanTimes, StartPrior, register_ct_ndt, register_ct_ndt_free_start,
+    register_icp, register_ndt,
 };
 use std::time::Instant;
 
@@ -33,6 +33,9 @@ pub struct Tracker {
     last: Option<LastPose>,
     lost: bool,
     consecutive_degraded: u32,
+    /// The last registration held a rotation at the prediction (see
+    /// `TrackerConfig::release_lever_arm_m`).
+    holding: bool,
 }
 
 impl Tracker {
@@ -53,6 +56,7 @@ impl Tracker {
             last: None,
             lost: false,
             consecutive_degraded: 0,
+            holding: false,
         })
     }
 
@@ -116,6 +120,7 @@ impl Tracker {
         });
         self.lost = false;
         self.consecutive_degraded = 0;
+        self.holding = false;
         Ok(())
     }
 
@@ -189,6 +194,7 @@ impl Tracker {
             }
         };
         let registration_ms = ms(reg_start);
+        self.holding = registration.degenerate_directions > 0;
         let mut out = self.assess(
             registration,
             &prediction,
@@ -232,10 +238,21 @@ impl Tracker {
         let previous = last.t_sensor_target.inverse();
         let predicted = prediction.pose.inverse();
         let (map, c) = (&self.model.map, &self.config);
+        // Hysteresis of the degeneracy handling: while a rotation is held,
+        // it is released only above `release_lever_arm_m`.
+        let held = NdtParams {
+            min_lever_arm_m: c.release_lever_arm_m.max(c.ndt.min_lever_arm_m),
+            ..c.ndt
+        };
+        let ndt = if self.holding && c.ndt.min_lever_arm_m > 0.0 {
+            &held
+        } else {
+            &c.ndt
+        };
         Ok(match c.mode {
-            TrackingMode::Ndt => register_ndt(map, cloud, &previous, &c.ndt)?,
+            TrackingMode::Ndt => register_ndt(map, cloud, &previous, ndt)?,
             TrackingMode::Icp => register_icp(self.model.icp()?, cloud, &previous, &c.icp)?,
-            TrackingMode::Deblur => register_ndt(map, cloud, &predicted, &c.ndt)?,
+            TrackingMode::Deblur => register_ndt(map, cloud, &predicted, ndt)?,
             TrackingMode::CtNdt => {
                 let scan = ScanTimes {
                     start_s: scan_start,
@@ -244,12 +261,11 @@ impl Tracker {
                 match c.ct_start {
                     CtStart::Fixed => {
                         let start = self.fixed_ct_start(last, scan_start)?;
-                        register_ct_ndt(map, cloud, &scan, &start, &predicted, &c.ndt)?
+                        register_ct_ndt(map, cloud, &scan, &start, &predicted, ndt)?
                     }
                     CtStart::FilterPrior => {
                         let prior = self.ct_start_prior(scan_start)?;
-                        register_ct_ndt_free_start(map, cloud, &scan, &prior, &predicted, &c.ndt)?
-                            .end
+                        register_ct_ndt_free_start(map, cloud, &scan, &prior, &predicted, ndt)?.end
                     }
                 }
             }
@@ -270,16 +286,19 @@ impl Tracker {
 
     /// The prior on `T^s` ([`CtStart::FilterPrior`]): the filter's estimate
     /// at the scan start, its covariance carried through the inversion to
-    /// `t_target_sensor`. Its units are those of the registration's
-    /// information, which the filter fuses as measurement information.
+    /// `t_target_sensor`. The filter fuses the registration's covariance
+    /// times `filter.registration_covariance_scale`, so its covariance is
+    /// divided by that factor to be in the units of the registration's own
+    /// information, against which the prior weighs in the optimisation.
     fn ct_start_prior(&self, scan_start: f64) -> Result<StartPrior, TrackError> {
         let at_start = self.filter.predict_at(scan_start)?;
         let a = inversion_jacobian(&at_start.pose);
         let cov = a * at_start.covariance * a.transpose();
         let cov = (cov + cov.transpose()) * 0.5;
+        let scale = self.filter.config().registration_covariance_scale;
         let information = cov
             .cholesky()
-            .map(|c| c.inverse())
+            .map(|c| c.inverse() * scale)
             .ok_or(TrackError::NoStartPrior { t_s: scan_start })?;
         Ok(StartPrior {
             t_target_sensor: at_start.pose.inverse(),

@@ -17,7 +17,7 @@
 //! The reported information is that of `T^e` with `T^s` marginalised out
 //! (Schur complement), the reported cost that of the points alone.
 
-use super::{Interpolation, ScanTimes, constrained_directions};
+use super::{Interpolation, ScanTimes, constrained_directions, exp_coefficients};
 use crate::error::RegistrationError;
 use crate::ndt_map::NdtMap;
 use crate::normal_equations::{Constrained, increment_of};
@@ -29,7 +29,6 @@ use spacepose_geometry::{Point, Pose, so3};
 
 type Matrix12 = SMatrix<f64, 12, 12>;
 type Vector12 = SVector<f64, 12>;
-type Matrix3x12 = SMatrix<f64, 3, 12>;
 
 /// A Gaussian prior on the start pose `T^s = t_target_sensor` of a scan.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -92,14 +91,37 @@ impl Joint {
         }
     }
 
-    fn add(&mut self, j: &Matrix3x12, p: &Matrix3<f64>, r: &Vector3<f64>) {
-        let pj = p * j;
+    /// Adds one residual with Jacobian blocks `[A_s B_s A_e B_e]` (rotation
+    /// and translation of each end); only the upper block triangle of `h`
+    /// is accumulated ([`Joint::mirror`] completes it).
+    fn add(&mut self, blocks: &[Matrix3<f64>; 4], p: &Matrix3<f64>, r: &Vector3<f64>) {
+        let pb = blocks.map(|b| p * b);
+        for i in 0..4 {
+            for j in i..4 {
+                let mut hv = self.h.fixed_view_mut::<3, 3>(3 * i, 3 * j);
+                hv += blocks[i].tr_mul(&pb[j]);
+            }
+        }
         let pr = p * r;
-        self.h += j.tr_mul(&pj);
-        self.g += j.tr_mul(&pr);
+        for (i, b) in blocks.iter().enumerate() {
+            let mut gv = self.g.fixed_rows_mut::<3>(3 * i);
+            gv += b.tr_mul(&pr);
+        }
         self.cost += r.dot(&pr);
         self.squared_distance += r.norm_squared();
         self.inliers += 1;
+    }
+
+    /// Copies the upper block triangle of `h` to the lower one.
+    fn mirror(&mut self) {
+        for i in 0..4 {
+            for j in (i + 1)..4 {
+                let upper = self.h.fixed_view::<3, 3>(3 * i, 3 * j).transpose();
+                self.h
+                    .fixed_view_mut::<3, 3>(3 * j, 3 * i)
+                    .copy_from(&upper);
+            }
+        }
     }
 
     /// Adds the prior `½ eᵀ Ω e` with `e = T^s ⊖ T^s₀`; `∂e/∂δ^s` is
@@ -175,20 +197,27 @@ fn linearise(
     let forward = Interpolation::new(start, end);
     let backward = Interpolation::new(end, start);
     let mut joint = Joint::new();
-    let mut j = Matrix3x12::zeros();
-    for (z, u) in points.iter().step_by(stride.max(1)) {
-        let le = forward.apply(&(start.rotation * z), *u);
+    let phi2 = forward.phi.norm_squared();
+    for &(z, u) in points.iter().step_by(stride.max(1)) {
+        // Backward: `φ' = -φ`, factor `1 - u`, so its two coefficient sets
+        // are the forward ones swapped.
+        let (c_u, c_v) = (
+            exp_coefficients(phi2 * u * u),
+            exp_coefficients(phi2 * (1.0 - u) * (1.0 - u)),
+        );
+        let le = forward.apply_with(&(start.rotation * z), u, c_u, c_v);
         let Some((k, _)) = map.nearest_cell(&le.point, params.max_distance_m, params.lookup) else {
             continue;
         };
-        let ls = backward.apply(&(end.rotation * z), 1.0 - *u);
-        j.fixed_view_mut::<3, 3>(0, 0).copy_from(&ls.j_r);
-        j.fixed_view_mut::<3, 3>(0, 3).copy_from(&ls.j_t);
-        j.fixed_view_mut::<3, 3>(0, 6).copy_from(&le.j_r);
-        j.fixed_view_mut::<3, 3>(0, 9).copy_from(&le.j_t);
+        let ls = backward.apply_with(&(end.rotation * z), 1.0 - u, c_v, c_u);
         let (mean, information) = map.mean_and_information(k);
-        joint.add(&j, information, &(le.point - mean));
+        joint.add(
+            &[ls.j_r, ls.j_t, le.j_r, le.j_t],
+            information,
+            &(le.point - mean),
+        );
     }
+    joint.mirror();
     joint
 }
 
