@@ -96,10 +96,10 @@ impl Joint {
     /// is accumulated ([`Joint::mirror`] completes it).
     fn add(&mut self, blocks: &[Matrix3<f64>; 4], p: &Matrix3<f64>, r: &Vector3<f64>) {
         let pb = blocks.map(|b| p * b);
-        for i in 0..4 {
-            for j in i..4 {
+        for (i, b) in blocks.iter().enumerate() {
+            for (j, pbj) in pb.iter().enumerate().skip(i) {
                 let mut hv = self.h.fixed_view_mut::<3, 3>(3 * i, 3 * j);
-                hv += blocks[i].tr_mul(&pb[j]);
+                hv += b.tr_mul(pbj);
             }
         }
         let pr = p * r;
