@@ -401,6 +401,24 @@ mod tests {
     use nalgebra::Vector3;
     use spacepose_geometry::{Pose, so3};
 
+    /// The documented example parses and shows the library defaults.
+    #[test]
+    fn the_deploy_example_is_valid() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../deploy/examples/filter.toml"
+        );
+        let text = std::fs::read_to_string(path).unwrap();
+        let c: FilterServiceConfig = toml::from_str(&text).unwrap();
+        c.filter.validate().unwrap();
+        let d = FilterConfig::default();
+        assert_eq!(c.filter.q_pos, d.q_pos);
+        assert_eq!(
+            c.filter.registration_covariance_scale,
+            d.registration_covariance_scale
+        );
+    }
+
     fn pose_at(t: f64) -> Pose {
         Pose::new(
             so3::exp(&Vector3::new(0.0, 0.0, 0.1 * t)),

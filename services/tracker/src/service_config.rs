@@ -186,6 +186,21 @@ mod tests {
         assert!(toml::from_str::<TrackerServiceConfig>("[tracker]\nmod = \"ndt\"\n").is_err());
     }
 
+    /// The documented example parses, validates and shows the defaults.
+    #[test]
+    fn the_deploy_example_is_valid() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../deploy/examples/tracker.toml"
+        );
+        let text = std::fs::read_to_string(path).unwrap();
+        let c: TrackerServiceConfig = toml::from_str(&text).unwrap();
+        c.validate().unwrap();
+        let d = crate::TrackerConfig::default();
+        assert_eq!(c.tracker.ct_start, d.ct_start);
+        assert_eq!(c.tracker.release_lever_arm_m, d.release_lever_arm_m);
+    }
+
     #[test]
     fn unknown_targets_and_corrupt_maps_are_errors() {
         let c = TrackerServiceConfig {
