@@ -10,11 +10,6 @@ use serde::{Deserialize, Serialize};
 #[serde(default, deny_unknown_fields)]
 pub struct FilterConfig {
     /// White-acceleration spectral density of the position filter (m²/s³).
-    /// Default 3e-3, i.e. 1e-4 times `registration_covariance_scale`: the
-    /// position filter keeps the gain it had with the unscaled covariance
-    /// (with 1e-4 and the scale of 30 it lagged the fly-around by 12-24 cm
-    /// and lost track on seed 11's sparse frames), so the scale only slows
-    /// the attitude filter down.
     pub q_pos: f64,
     /// White-noise density on the attitude (rad²/s).
     pub q_rot: f64,
@@ -28,14 +23,8 @@ pub struct FilterConfig {
     /// false the fixed noise above is always used.
     pub use_registration_covariance: bool,
     /// Factor applied to the registration's covariance (registration
-    /// Hessians tend to be over-confident). Default 30, tuned on the
-    /// tracking seed 1 (tumbling, 1 / 10 / 30 / 100 / 300): with 1 the
-    /// filter took each NDT pose as nearly exact, its angular velocity
-    /// followed the frame-to-frame noise (±0.1-0.3°/s about the spin) and
-    /// one frame with a weak roll constraint shifted it by 0.75°/s (the
-    /// roll then drifted at that rate while unobservable: ct-ndt max 57°);
-    /// with 30 deblur's max after warm-up went 5.38 → 3.96°, ct-ndt's
-    /// 57.1 → 7.3°; with 100 and more ct-ndt lost track.
+    /// Hessians tend to be over-confident). Default 1; the tracker's
+    /// `ct_ndt_attitude_covariance_scale` scales ct-ndt's attitude itself.
     pub registration_covariance_scale: f64,
     /// Initial attitude uncertainty, per axis (deg, 1σ).
     pub initial_sigma_rot_deg: f64,
@@ -54,13 +43,13 @@ pub struct FilterConfig {
 impl Default for FilterConfig {
     fn default() -> Self {
         Self {
-            q_pos: 3e-3,
+            q_pos: 1e-4,
             q_rot: 1e-6,
             q_w: 1e-6,
             sigma_rot_deg: 1.0,
             sigma_pos_m: 0.02,
             use_registration_covariance: true,
-            registration_covariance_scale: 30.0,
+            registration_covariance_scale: 1.0,
             initial_sigma_rot_deg: 2.0,
             initial_sigma_pos_m: 0.05,
             initial_sigma_v_mps: 0.5,

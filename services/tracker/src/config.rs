@@ -107,6 +107,17 @@ pub struct TrackerConfig {
     pub geometric_sigma_m: f64,
     /// Start pose of the `ct-ndt` scan (see [`CtStart`]).
     pub ct_start: CtStart,
+    /// In `ct-ndt` mode, the attitude block of the measurement covariance
+    /// the filter fuses is multiplied by this (1 = NDT's information as
+    /// is). Why: CT-NDT's end pose is extrapolated from the scan, and with
+    /// its Hessian as the covariance the filter's angular velocity followed
+    /// the frame-to-frame noise (±0.1-0.3°/s about the spin); one frame with
+    /// a weak roll constraint shifted it by 0.75°/s, and the roll drifted
+    /// at that rate once unobservable. Tuned on seed 1 (tumbling) over 1,
+    /// 10, 30, 100, 300 (ct-ndt max after warm-up 57.1, 10.0, 7.3°, lost,
+    /// lost; the position was scaled with it then, which `deblur` did not
+    /// survive on seeds 1 or 11, hence attitude only and ct-ndt only).
+    pub ct_ndt_attitude_covariance_scale: f64,
     /// Relative-motion filter tuning.
     pub filter: FilterConfig,
     /// Degraded / lost thresholds.
@@ -149,6 +160,7 @@ impl Default for TrackerConfig {
             icp: IcpParams::default(),
             geometric_sigma_m: 0.0,
             ct_start: CtStart::default(),
+            ct_ndt_attitude_covariance_scale: 30.0,
             // The tracker checks consistency with absolute innovation limits
             // (`LossConfig`): the registration's information is far more
             // confident than the model errors justify, so a χ² gate on it
@@ -178,6 +190,13 @@ impl TrackerConfig {
             return Err(bad(
                 "voxel_leaf_m must be finite and > 0",
                 self.voxel_leaf_m,
+            ));
+        }
+        let s = self.ct_ndt_attitude_covariance_scale;
+        if !(s.is_finite() && s > 0.0) {
+            return Err(bad(
+                "ct_ndt_attitude_covariance_scale must be finite and > 0",
+                s,
             ));
         }
         if !(self.release_lever_arm_m.is_finite() && self.release_lever_arm_m >= 0.0) {

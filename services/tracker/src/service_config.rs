@@ -199,6 +199,10 @@ mod tests {
         let d = crate::TrackerConfig::default();
         assert_eq!(c.tracker.ct_start, d.ct_start);
         assert_eq!(c.tracker.release_lever_arm_m, d.release_lever_arm_m);
+        assert_eq!(
+            c.tracker.ct_ndt_attitude_covariance_scale,
+            d.ct_ndt_attitude_covariance_scale
+        );
     }
 
     #[test]

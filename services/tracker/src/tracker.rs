@@ -7,7 +7,7 @@ use crate::mode::TrackingMode;
 use crate::model::TrackingModel;
 use crate::output::{Timings, TrackOutput};
 use crate::status::TrackStatus;
-use nalgebra::Vector3;
+use nalgebra::{Matrix6, Vector3, Vector6};
 use spacepose_filter::{MotionCompensation, Prediction, RelativeMotionFilter};
 use spacepose_geometry::{Point, Pose, VoxelFilter, so3};
 use spacepose_registration::{
@@ -15,6 +15,13 @@ use spacepose_registration::{
     register_icp, register_ndt,
 };
 use std::time::Instant;
+
+/// `diag(√s I₃, I₃)`: scales the attitude block of a `[rot; trans]`
+/// covariance by `s` and the cross blocks by `√s`.
+fn attitude_scaling(s: f64) -> Matrix6<f64> {
+    let r = s.sqrt();
+    Matrix6::from_diagonal(&Vector6::new(r, r, r, 1.0, 1.0, 1.0))
+}
 
 /// The last pose the tracker produced.
 #[derive(Debug, Clone, Copy)]
@@ -295,15 +302,34 @@ impl Tracker {
         let a = inversion_jacobian(&at_start.pose);
         let cov = a * at_start.covariance * a.transpose();
         let cov = (cov + cov.transpose()) * 0.5;
+        // Undo what the measurements were inflated by before the filter.
+        let d = attitude_scaling(self.ct_attitude_scale()).try_inverse();
         let scale = self.filter.config().registration_covariance_scale;
-        let information = cov
-            .cholesky()
+        let information = d
+            .map(|d| d * cov * d)
+            .and_then(|c| c.cholesky())
             .map(|c| c.inverse() * scale)
             .ok_or(TrackError::NoStartPrior { t_s: scan_start })?;
         Ok(StartPrior {
             t_target_sensor: at_start.pose.inverse(),
             information,
         })
+    }
+
+    /// `TrackerConfig::ct_ndt_attitude_covariance_scale` in `ct-ndt` mode,
+    /// 1 otherwise.
+    fn ct_attitude_scale(&self) -> f64 {
+        match self.config.mode {
+            TrackingMode::CtNdt => self.config.ct_ndt_attitude_covariance_scale,
+            _ => 1.0,
+        }
+    }
+
+    /// The measurement covariance `[rot; trans]` with its attitude inflated
+    /// by [`Tracker::ct_attitude_scale`] (`D C D`, `D = diag(√s I, I)`).
+    fn attitude_scaled(&self, c: Matrix6<f64>) -> Matrix6<f64> {
+        let d = attitude_scaling(self.ct_attitude_scale());
+        d * c * d
     }
 
     /// Quality and consistency checks, filter update, status.
@@ -320,7 +346,8 @@ impl Tracker {
             so3::distance(&measured.rotation, &prediction.pose.rotation).to_degrees();
         let innovation_pos_m = (measured.translation - prediction.pose.translation).norm();
         let information = measurement_information(&registration, self.config.geometric_sigma_m);
-        let covariance = covariance_sensor_target(&registration.t_target_sensor, &information);
+        let covariance = covariance_sensor_target(&registration.t_target_sensor, &information)
+            .map(|c| self.attitude_scaled(c));
         let mut reasons = self.quality_issues(&registration);
         let l = &self.config.loss;
         if innovation_rot_deg > l.max_innovation_rot_deg
@@ -453,4 +480,30 @@ impl Tracker {
 
 fn ms(since: Instant) -> f64 {
     since.elapsed().as_secs_f64() * 1e3
+}
+
+#[cfg(test)]
+mod scaling_tests {
+    use super::attitude_scaling;
+    use nalgebra::Matrix6;
+
+    /// `D C D` multiplies the attitude block by `s`, the cross blocks by
+    /// `√s`, and leaves the position block alone.
+    #[test]
+    fn attitude_scaling_scales_the_blocks() {
+        let c = Matrix6::from_fn(|i, j| 1.0 + (i + j) as f64 + if i == j { 10.0 } else { 0.0 });
+        let d = attitude_scaling(30.0);
+        let scaled = d * c * d;
+        for i in 0..6 {
+            for j in 0..6 {
+                let f = match (i < 3, j < 3) {
+                    (true, true) => 30.0,
+                    (false, false) => 1.0,
+                    _ => 30f64.sqrt(),
+                };
+                assert!((scaled[(i, j)] - f * c[(i, j)]).abs() < 1e-9, "({i}, {j})");
+            }
+        }
+        assert_eq!(attitude_scaling(1.0), Matrix6::identity());
+    }
 }

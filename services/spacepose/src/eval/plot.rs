@@ -133,7 +133,7 @@ where
                 .map(|(t, v)| (*t, *v))
                 .collect();
         chart
-            .draw_series(LineSeries::new(points, color.stroke_width(2)))
+            .draw_series(LineSeries::new(points, color.stroke_width(1)))
             .map_err(|e| anyhow::anyhow!("{e:?}"))?
             .label(s.label)
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
