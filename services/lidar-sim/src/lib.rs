@@ -28,7 +28,7 @@ pub mod simulator;
 pub mod surface;
 
 pub use clutter::Facility;
-pub use config::{Effects, SensorConfig};
+pub use config::{Effects, RASTER_SCAN_TIME_S, SensorConfig, SurfaceModel};
 pub use detection::{DetectionModel, DetectionParams};
 pub use error::SimError;
 pub use pattern::{Scan, ScanPattern, ScanRays};

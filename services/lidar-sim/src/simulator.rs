@@ -2,7 +2,7 @@
 //! integration window, each ray traced against the moving target (and the
 //! facility background), then detection, outliers and noise.
 
-use crate::config::SensorConfig;
+use crate::config::{SensorConfig, SurfaceModel};
 use crate::detection::DetectionModel;
 use crate::error::SimError;
 use crate::optics::tilt;
@@ -96,6 +96,20 @@ impl LidarSimulator {
         &self.target
     }
 
+    /// The surfaces of one frame, indexed by material. The Phong draws are
+    /// made under both models so that the rest of the frame's random stream
+    /// (noise, outliers, detection) does not depend on the surface model.
+    fn frame_surfaces(&self, rng: &mut ChaCha8Rng) -> Vec<Surface> {
+        let drawn = draw_surfaces(self.target.materials(), rng);
+        match self.config.surface_model {
+            SurfaceModel::Phong => drawn,
+            SurfaceModel::Lambertian => drawn
+                .iter()
+                .map(|s| Surface::lambertian(s.reflectance))
+                .collect(),
+        }
+    }
+
     /// An independent, reproducible random stream for frame `frame_index` of
     /// a run seeded with `seed` (ChaCha8, one stream per frame).
     pub fn frame_rng(seed: u64, frame_index: u64) -> ChaCha8Rng {
@@ -145,7 +159,7 @@ impl LidarSimulator {
                 t_end: truth.t,
                 blur: fx.motion_blur,
             },
-            surfaces: draw_surfaces(self.target.materials(), rng),
+            surfaces: self.frame_surfaces(rng),
             clutter: if fx.clutter {
                 c.facility.build(&self.target, &truth.t_sensor_target)
             } else {

@@ -1,6 +1,6 @@
 //! End-to-end tests of the simulator on the built-in `deos` target.
 
-use crate::{Effects, Frame, LidarSimulator, ReturnKind, SensorConfig, SimError};
+use crate::{Effects, Frame, LidarSimulator, ReturnKind, SensorConfig, SimError, SurfaceModel};
 use nalgebra::{Rotation3, Vector3};
 use spacepose_geometry::{Point, Pose};
 use spacepose_scenario::TruthState;
@@ -330,7 +330,7 @@ fn raster_sensor_gives_a_sparse_cloud_and_rejects_bad_truth() {
         frame.points.len()
     );
     assert!(frame.points.len() > 50 && frame.points.len() < 41 * 41);
-    assert!((frame.scan_end - frame.scan_start - 1.0).abs() < 1e-12);
+    assert!((frame.scan_end - frame.scan_start - crate::RASTER_SCAN_TIME_S).abs() < 1e-12);
     let mut bad = static_truth();
     bad.v_sensor_target.x = f64::NAN;
     let mut rng = LidarSimulator::frame_rng(0, 0);
@@ -339,6 +339,51 @@ fn raster_sensor_gives_a_sparse_cloud_and_rejects_bad_truth() {
         Err(SimError::NonFiniteTruth(_))
     ));
     assert!(sim.simulate(&bad, &mut rng).points.is_empty());
+}
+
+/// Seed 002's raster with its Lambertian return keeps most of ENVISAT's
+/// geometric points at 50 m (the paper: ~120 points there), where seed 004's
+/// specular solar array would vanish.
+#[test]
+fn seed002_raster_sees_the_solar_array_at_50_m() {
+    let envisat = Arc::new(Target::builtin("envisat").unwrap());
+    let count = |surface_model: SurfaceModel, effects: Effects| {
+        let config = SensorConfig {
+            surface_model,
+            effects,
+            ..SensorConfig::raster_seed002()
+        };
+        let sim = LidarSimulator::new(envisat.clone(), config).unwrap();
+        (0..8u64)
+            .map(|k| {
+                let a = k as f64;
+                let truth = TruthState {
+                    t: 100.0,
+                    t_sensor_target: Pose::new(
+                        Rotation3::from_euler_angles(0.7 * a, 0.4 * a - 1.2, 1.1 * a),
+                        Vector3::new(0.0, 0.0, 50.0),
+                    ),
+                    v_sensor_target: Vector3::zeros(),
+                    w_target: Vector3::zeros(),
+                };
+                run(&sim, &truth, k).points.len()
+            })
+            .sum::<usize>()
+    };
+    let ideal = count(SurfaceModel::Lambertian, Effects::none());
+    let lambertian = count(SurfaceModel::Lambertian, Effects::default());
+    let phong = count(SurfaceModel::Phong, Effects::default());
+    println!("envisat at 50 m, 8 attitudes: ideal {ideal}, Lambertian {lambertian}, Phong {phong}");
+    assert!(lambertian as f64 > 0.85 * ideal as f64);
+    assert!((phong as f64) < 0.75 * lambertian as f64);
+    assert_eq!(
+        SensorConfig::raster_seed002().surface_model,
+        SurfaceModel::Lambertian
+    );
+    assert_eq!(
+        SensorConfig::livox_mid40().surface_model,
+        SurfaceModel::Phong
+    );
 }
 
 #[test]
