@@ -31,6 +31,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "screen" => c.screen_candidates = v.parse()?,
             "screen_iters" => c.screen_iterations = v.parse()?,
             "budget" => c.screen_point_budget = v.parse()?,
+            "screen_pts" => c.screen_max_points = v.parse()?,
+            "recentre" => c.recentre_iterations = v.parse()?,
             "stride" => c.template_stride = v.parse()?,
             "coarse" => {
                 let (s, n) = v.split_once(':').ok_or("coarse=stride:keep")?;
@@ -116,6 +118,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let e = so3::distance(&truth, &o.t_sensor_target.rotation).to_degrees();
                 let ec = so3::distance(&truth, &o.t_sensor_target_coarse.rotation).to_degrees();
                 if verbose {
+                    let d = o.t_sensor_target.translation - frame.truth.t_sensor_target.translation;
+                    let body = frame.truth.t_sensor_target.rotation.inverse() * d;
+                    println!(
+                        "frame {i}: final pos err {:.2} m, in body axes [{:.2}, {:.2}, {:.2}]",
+                        d.norm(),
+                        body.x,
+                        body.y,
+                        body.z
+                    );
                     println!(
                         "frame {i}: pts {} err {e:.1} coarse {ec:.1} f_conv {:.2e} rank {} centroid-truth {:.2} m, coarse pos err {:.2} m, {:.0} ms",
                         frame.points.len(),

@@ -17,6 +17,7 @@ pub mod matcher;
 pub mod outcome;
 pub mod refine;
 pub mod template;
+pub mod visibility;
 
 pub use config::{CoarseToFine, TemplateMatchingConfig, Threads};
 pub use correlation::{Centering, Correlator, d_bor, d_bor_passes};
@@ -27,3 +28,4 @@ pub use outcome::AcquisitionOutcome;
 pub use refine::{Refined, refine, refine_with_stages, screen};
 pub use spacepose_registration::IcpParams;
 pub use template::{TemplateRenderer, template_directions};
+pub use visibility::SensedTree;

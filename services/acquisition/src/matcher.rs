@@ -8,6 +8,7 @@ use crate::grid::euler_grid;
 use crate::outcome::AcquisitionOutcome;
 use crate::refine::{Refined, refine_with_stages, screen};
 use crate::template::TemplateRenderer;
+use crate::visibility::SensedTree;
 use nalgebra::{Rotation3, Vector3};
 use rayon::prelude::*;
 use spacepose_geometry::{Euler321, Point, Pose, so3};
@@ -52,6 +53,9 @@ pub struct TemplateMatcher {
     grid: Vec<(Euler321, Rotation3<f64>)>,
     renderer: TemplateRenderer,
     coarse_renderer: Option<TemplateRenderer>,
+    /// Tolerance of the reverse check (rad): `unexplained_spacings` times
+    /// the sensor's ray spacing.
+    tolerance_rad: f64,
     icp_model: IcpModel,
     /// The coarser model of the wide ICP stages, if configured.
     stage_model: Option<IcpModel>,
@@ -77,6 +81,8 @@ impl TemplateMatcher {
         let coarse_renderer = config
             .coarse_to_fine
             .map(|c| TemplateRenderer::new(target.clone(), &sensor, c.stride));
+        let tolerance_rad = config.unexplained_spacings
+            * TemplateRenderer::new(target.clone(), &sensor, 1).ray_spacing_rad();
         let model = target.sample_surface(config.model_spacing_m, MODEL_SEED);
         let icp_model = IcpModel::new(&model)?;
         let stage_model = if config.stage_model_spacing_m > 0.0 {
@@ -92,6 +98,7 @@ impl TemplateMatcher {
             grid,
             renderer,
             coarse_renderer,
+            tolerance_rad,
             icp_model,
             stage_model,
         })
@@ -212,7 +219,8 @@ impl TemplateMatcher {
 
         // Template solution(s): grid attitude, origin from the centroid alignment.
         let refine_start = Instant::now();
-        let (candidates, starts, screened) = self.screened_candidates(&ranked, &finite);
+        let (candidates, starts, screened) =
+            self.screened_candidates(&ranked, &finite, &centre, centering);
         // After screening, the wide stages have been run: only the
         // narrowest is repeated, on the full model, before the final one.
         let stages = &self.config.icp_stages_m;
@@ -234,12 +242,28 @@ impl TemplateMatcher {
                 .map_err(|e| e.to_string())
             })
             .collect();
+        let sensed_tree = SensedTree::new(&positions);
+        let unexplained: Vec<f64> = refined
+            .iter()
+            .map(|r| match r {
+                Ok(r) => self.unexplained(&sensed_tree, &r.t_sensor_target),
+                Err(_) => 1.0,
+            })
+            .collect();
         let refinement_ms = ms_since(refine_start);
+        let w = self.config.unexplained_weight_m2;
+        let score = |i: usize, r: &Refined| {
+            if w > 0.0 {
+                r.f_conv_m2 + w * unexplained[i]
+            } else {
+                r.f_conv_m2
+            }
+        };
         let best = refined
             .iter()
             .enumerate()
             .filter_map(|(i, r)| r.as_ref().ok().map(|r| (i, r)))
-            .min_by(|a, b| a.1.f_conv_m2.total_cmp(&b.1.f_conv_m2));
+            .min_by(|a, b| score(a.0, a.1).total_cmp(&score(b.0, b.1)));
         let coarse_of = |rank: usize| candidates[rank].1;
         let c_of = |rank: usize| {
             let k = candidates[rank].0;
@@ -266,7 +290,12 @@ impl TemplateMatcher {
                     refined.first().and_then(|r| r.as_ref().err().cloned()),
                 ),
             };
+        let unexplained_fraction = match best {
+            Some((i, _)) => unexplained[i],
+            None => 1.0,
+        };
         let f_conv_ok = f_conv.is_finite() && f_conv <= self.config.f_max_m2;
+        let explained = unexplained_fraction <= self.config.u_max;
         let chosen_k = candidates[chosen_rank].0;
         Ok(AcquisitionOutcome {
             t_sensor_target: pose,
@@ -275,7 +304,8 @@ impl TemplateMatcher {
             centroid_m: [centre.x, centre.y, centre.z],
             correlation_m2: c_of(chosen_rank),
             f_conv_m2: f_conv,
-            accepted: f_conv_ok,
+            unexplained_fraction,
+            accepted: f_conv_ok && explained,
             templates_generated: generated,
             templates_evaluated: evaluated,
             templates_rejected: rejected,
@@ -301,17 +331,26 @@ impl TemplateMatcher {
         &self,
         ranked: &[(usize, f64, Vector3<f64>)],
         cloud: &[Point],
+        centre: &Vector3<f64>,
+        centering: Centering,
     ) -> (Vec<(usize, Pose)>, Vec<Pose>, usize) {
         let c = &self.config;
         let keep = c.icp_candidates;
+        let subsample = strided(cloud, c.screen_max_points);
         let mut count = keep.max(c.screen_candidates);
         if c.screen_point_budget > 0 {
-            count = count.min((c.screen_point_budget / cloud.len().max(1)).max(keep));
+            count = count.min((c.screen_point_budget / subsample.len().max(1)).max(keep));
         }
         let templates: Vec<(usize, Pose)> = self
             .distinct_candidates(ranked, count)
             .into_iter()
-            .map(|(k, origin)| (k, Pose::new(self.grid[k].1, origin)))
+            .map(|(k, origin)| {
+                let r = self.grid[k].1;
+                (
+                    k,
+                    Pose::new(r, self.recentre(&r, origin, centre, centering)),
+                )
+            })
             .collect();
         let unscreened = |t: Vec<(usize, Pose)>| {
             let t: Vec<(usize, Pose)> = t.into_iter().take(keep).collect();
@@ -325,7 +364,7 @@ impl TemplateMatcher {
             .iter()
             .enumerate()
             .filter_map(|(i, (_, pose))| {
-                screen(self.stage_model(), cloud, pose, c)
+                screen(self.stage_model(), &subsample, pose, c)
                     .ok()
                     .map(|(p, score)| (score, i, p))
             })
@@ -339,6 +378,46 @@ impl TemplateMatcher {
         let chosen = screened.iter().map(|&(_, i, _)| templates[i]).collect();
         let starts = screened.iter().map(|&(_, _, p)| p).collect();
         (chosen, starts, templates.len())
+    }
+
+    /// The unexplained fraction of `t_sensor_target` (see
+    /// [`crate::visibility`]).
+    fn unexplained(&self, sensed: &SensedTree, t_sensor_target: &Pose) -> f64 {
+        let mut template = Vec::new();
+        self.renderer.render_into(
+            &t_sensor_target.rotation,
+            &t_sensor_target.translation,
+            &mut template,
+        );
+        sensed.unexplained_fraction(&template, self.tolerance_rad)
+    }
+
+    /// The target origin of attitude `r` re-centred `recentre_iterations`
+    /// times: the template is rendered with the origin at `origin`, and the
+    /// origin moves by the sensor centre minus that template's centre.
+    /// Templates are scored rendered at the sensor centroid, and when the
+    /// field of view clips the target that render shows another part than
+    /// the sensor saw, so its alignment leaves the origin metres off; each
+    /// re-render clips like the sensor did.
+    fn recentre(
+        &self,
+        r: &Rotation3<f64>,
+        mut origin: Vector3<f64>,
+        centre: &Vector3<f64>,
+        centering: Centering,
+    ) -> Vector3<f64> {
+        let (mut template, mut scratch) = (Vec::new(), Vec::new());
+        for _ in 0..self.config.recentre_iterations {
+            self.renderer.render_into(r, &origin, &mut template);
+            if template.len() < 3 {
+                break;
+            }
+            match centering.centre(&template, &mut scratch) {
+                Some(c) => origin += centre - c,
+                None => break,
+            }
+        }
+        origin
     }
 
     /// The `count` best templates, skipping any closer than
@@ -464,3 +543,14 @@ fn ms_since(t: Instant) -> f64 {
 #[cfg(test)]
 #[path = "matcher_tests.rs"]
 mod tests;
+
+/// An evenly strided subsample of about `max_points` of `cloud` (all of it
+/// when `max_points` is 0 or the cloud is no larger).
+fn strided(cloud: &[Point], max_points: usize) -> Vec<Point> {
+    let stride = if max_points > 0 && cloud.len() > max_points {
+        cloud.len().div_ceil(max_points)
+    } else {
+        1
+    };
+    cloud.iter().step_by(stride).copied().collect()
+}

@@ -57,7 +57,10 @@ fn noise_free_envisat_at_20_m_is_recovered_after_icp() {
     assert_eq!(out.templates_generated, 605 + 30);
     assert_eq!(out.templates_evaluated, 30);
     let coarse_deg = so3::distance(&out.t_sensor_target_coarse.rotation, &r).to_degrees();
-    assert!(coarse_deg < 45.0, "{coarse_deg}");
+    // Screening refines the candidate whose short ICP fit best, not
+    // necessarily the grid attitude nearest the truth (≤ 26° at Δ = 30°):
+    // here a neighbour 49° away, re-centred, converged.
+    assert!(coarse_deg < 60.0, "{coarse_deg}");
 }
 
 #[test]
@@ -139,6 +142,7 @@ fn single_thread_and_parallel_agree() {
         grid: m.grid.clone(),
         renderer: m.renderer.clone(),
         coarse_renderer: None,
+        tolerance_rad: m.tolerance_rad,
         icp_model: IcpModel::new(&m.target.sample_surface(0.3, 1)).unwrap(),
         stage_model: None,
     };
@@ -211,4 +215,52 @@ fn screening_follows_its_budget_and_recovers_the_pose() {
         TemplateMatcher::new(envisat(), SensorConfig::raster_seed002(), config(points)).unwrap();
     let out = m.acquire(&cloud).unwrap();
     assert_eq!((out.candidates_screened, out.candidates_refined), (0, 2));
+}
+
+/// The reverse check: the true pose explains its own noise-free frame, a
+/// half-turn about the line of sight's normal (which puts the solar array
+/// where the sensor saw the far end) does not.
+#[test]
+fn a_flipped_pose_leaves_template_points_unexplained() {
+    let m = matcher();
+    let r = Euler321::from_degrees(30.0, 20.0, -60.0).to_rotation();
+    let truth = Pose::new(r, Vector3::new(0.5, 0.2, 40.0));
+    let cloud = frame(truth, Effects::none(), 3);
+    let positions: Vec<Vector3<f64>> = cloud.iter().map(Point::position).collect();
+    let sensed = SensedTree::new(&positions);
+    let own = m.unexplained(&sensed, &truth);
+    let flip = Rotation3::from_axis_angle(&Vector3::y_axis(), std::f64::consts::PI) * r;
+    let flipped = m.unexplained(&sensed, &Pose::new(flip, truth.translation));
+    assert!(own < 0.02, "{own}");
+    assert!(flipped > 0.3, "{flipped}");
+    // 1° raster, 1.5 spacings.
+    assert!(
+        (m.tolerance_rad.to_degrees() - 1.5).abs() < 0.1,
+        "{}",
+        m.tolerance_rad
+    );
+}
+
+/// Re-centring: at 30 m the 40° field of view spans ±10.9 m; ENVISAT (26 m
+/// long, x from −21 to +5 m in its body frame) placed 14 m off the
+/// boresight is cut at the body's end. The template rendered at the sensed
+/// centroid is cut elsewhere, so the centroid alignment leaves the origin
+/// metres off; re-rendering at the aligned origin brings it back.
+#[test]
+fn recentring_undoes_the_field_of_view_clipping() {
+    let m = matcher();
+    let r = Euler321::from_degrees(0.0, 0.0, 0.0).to_rotation();
+    let truth = Pose::new(r, Vector3::new(14.0, 0.0, 30.0));
+    let cloud = frame(truth, Effects::none(), 4);
+    let positions: Vec<Vector3<f64>> = cloud.iter().map(Point::position).collect();
+    let mut scratch = Vec::new();
+    let centre = Centering::Mean.centre(&positions, &mut scratch).unwrap();
+    let template = m.renderer.render(&r, &centre);
+    let aligned = centre + centre - Centering::Mean.centre(&template, &mut scratch).unwrap();
+    let recentred = m.recentre(&r, aligned, &centre, Centering::Mean);
+    let before = (aligned - truth.translation).norm();
+    let after = (recentred - truth.translation).norm();
+    assert!(before > 1.0, "alignment alone is {before} m off");
+    // Two re-renders (the default): 9.96 → 6.17 m here.
+    assert!(after < 0.7 * before, "{before} → {after} m");
 }

@@ -24,7 +24,12 @@ pub struct AcquisitionOutcome {
     /// f_CONV: mean squared distance of every point to the model at ICP
     /// convergence (m²); infinite when every refinement failed.
     pub f_conv_m2: f64,
-    /// `f_conv_m2 <= f_max_m2`: the solution can initialise tracking.
+    /// Unexplained fraction of the solution: the share of the template
+    /// rendered at the refined pose that no sensed point explains (see
+    /// [`crate::visibility`]); 1 when every refinement failed.
+    pub unexplained_fraction: f64,
+    /// `f_conv_m2 <= f_max_m2` and `unexplained_fraction <= u_max`: the
+    /// solution can initialise tracking.
     pub accepted: bool,
     /// Templates rendered (both passes of coarse-to-fine count).
     pub templates_generated: usize,

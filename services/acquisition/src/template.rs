@@ -68,6 +68,35 @@ impl TemplateRenderer {
         self.directions.len()
     }
 
+    /// Median angle (rad) between a template ray and its nearest neighbour:
+    /// the angular sampling of the templates (1° for seed 002's raster).
+    /// 0 with fewer than two rays.
+    pub fn ray_spacing_rad(&self) -> f64 {
+        let entries: Vec<[f64; 3]> = self.directions.iter().map(|d| [d.x, d.y, d.z]).collect();
+        if entries.len() < 2 {
+            return 0.0;
+        }
+        let Ok(tree) = kiddo::ImmutableKdTree::<f64, 3>::new_from_slice(&entries) else {
+            return 0.0;
+        };
+        let mut nearest: Vec<f64> = entries
+            .iter()
+            .filter_map(|q| {
+                tree.query(q)
+                    .nearest_n::<kiddo::SquaredEuclidean<f64>>(std::num::NonZero::new(2)?)
+                    .execute()
+                    .get(1)
+                    .map(|n| n.distance.sqrt())
+            })
+            .collect();
+        if nearest.is_empty() {
+            return 0.0;
+        }
+        nearest.sort_by(f64::total_cmp);
+        // Chord to angle: 2 asin(c / 2).
+        2.0 * (nearest[nearest.len() / 2] / 2.0).min(1.0).asin()
+    }
+
     /// The noise-free cloud (sensor frame) of the target at
     /// `(r_sensor_target, t_sensor_target)`, written into `out` (cleared first).
     pub fn render_into(

@@ -77,6 +77,24 @@ pub struct TmOptions {
     /// points; 0 = no budget). Default: the library's (5000).
     #[arg(long)]
     pub screen_budget: Option<usize>,
+    /// Cloud points each screening ICP uses (0 = all). Default: the
+    /// library's.
+    #[arg(long)]
+    pub screen_max_points: Option<usize>,
+    /// Re-renderings of each candidate at its aligned origin before its
+    /// ICP (0 = seed 002's centroid alignment only). Default: the
+    /// library's.
+    #[arg(long)]
+    pub recentre_iterations: Option<usize>,
+    /// Weight (m²) of the unexplained fraction when the refined
+    /// candidates are compared (0 = by f_CONV alone). Default: the
+    /// library's.
+    #[arg(long)]
+    pub unexplained_weight: Option<f64>,
+    /// Acceptance bound on the unexplained fraction (1 = off). Default:
+    /// the library's.
+    #[arg(long)]
+    pub u_max: Option<f64>,
     /// Ray thinning of every template (1 = every sensor ray).
     #[arg(long, default_value_t = 1)]
     pub template_stride: usize,
@@ -87,9 +105,10 @@ pub struct TmOptions {
     /// ...then the best N templates at full resolution.
     #[arg(long, default_value_t = 30)]
     pub coarse_keep: usize,
-    /// Sensor points in the correlation (0 = all).
-    #[arg(long, default_value_t = 0)]
-    pub max_corr_points: usize,
+    /// Sensor points in the correlation (0 = all). Default: the
+    /// library's.
+    #[arg(long)]
+    pub max_corr_points: Option<usize>,
     /// f_MAX (m²) for the accepted flag.
     #[arg(long)]
     pub f_max: Option<f64>,
@@ -134,12 +153,16 @@ impl TmOptions {
             icp_candidates: self.icp_candidates.unwrap_or(d.icp_candidates),
             screen_candidates: self.screen_candidates.unwrap_or(d.screen_candidates),
             screen_point_budget: self.screen_budget.unwrap_or(d.screen_point_budget),
+            screen_max_points: self.screen_max_points.unwrap_or(d.screen_max_points),
+            recentre_iterations: self.recentre_iterations.unwrap_or(d.recentre_iterations),
+            unexplained_weight_m2: self.unexplained_weight.unwrap_or(d.unexplained_weight_m2),
+            u_max: self.u_max.unwrap_or(d.u_max),
             template_stride: self.template_stride,
             coarse_to_fine: (self.coarse_stride > 0).then_some(CoarseToFine {
                 stride: self.coarse_stride,
                 keep: self.coarse_keep,
             }),
-            max_correlation_points: self.max_corr_points,
+            max_correlation_points: self.max_corr_points.unwrap_or(d.max_correlation_points),
             robust_f_conv: self.robust_f_conv,
             ..d
         }
@@ -167,7 +190,11 @@ pub struct TmFrame {
     pub success: bool,
     /// f_CONV (m²), infinite when no refinement.
     pub f_conv_m2: f64,
-    /// f_CONV ≤ f_MAX.
+    /// Unexplained fraction of the solution (see
+    /// `spacepose_acquisition::visibility`), 1 when no refinement.
+    pub unexplained_fraction: f64,
+    /// The acquisition accepted the solution (f_CONV ≤ f_MAX and
+    /// unexplained fraction ≤ U_MAX).
     pub accepted: bool,
     /// Acquisition time (ms).
     pub time_ms: f64,
@@ -211,8 +238,12 @@ pub struct TmReport {
     pub config: TemplateMatchingConfig,
     /// Successes over frames.
     pub success_rate: f64,
-    /// Accepted (f_CONV ≤ f_MAX) over frames.
+    /// Accepted (f_CONV ≤ f_MAX and unexplained fraction ≤ U_MAX) over
+    /// frames.
     pub accepted_rate: f64,
+    /// Accepted successes over frames: how often a frame gives tracking a
+    /// correct pose it may use.
+    pub accepted_success_rate: f64,
     /// Accepted failures.
     pub false_accepts: usize,
     /// Rejected successes.
@@ -240,6 +271,11 @@ pub struct TmReport {
     pub fconv_failure_mean: f64,
     /// `fconv_success_max < fconv_failure_min`.
     pub separable: bool,
+    /// Unexplained fraction over the successes (max).
+    pub unexplained_success_max: f64,
+    /// Unexplained fraction over the failures that f_CONV alone would
+    /// accept (min; NaN without such failures).
+    pub unexplained_failure_min: f64,
     /// Mean points per frame.
     pub mean_points: f64,
     /// Every frame.
@@ -332,6 +368,7 @@ fn score(
         coarse_euler_err_deg: [f64::NAN; 3],
         success: false,
         f_conv_m2: f64::INFINITY,
+        unexplained_fraction: 1.0,
         accepted: false,
         time_ms: f64::NAN,
         matching_ms: f64::NAN,
@@ -357,6 +394,7 @@ fn score(
     rec.coarse_euler_err_deg = [0, 1, 2].map(|k| wrap_deg(e[k] - t[k]).abs());
     rec.success = rec.err_deg < SUCCESS_DEG;
     rec.f_conv_m2 = out.f_conv_m2;
+    rec.unexplained_fraction = out.unexplained_fraction;
     rec.accepted = out.accepted;
     rec.time_ms = out.time_ms;
     rec.matching_ms = out.matching_ms;
@@ -387,6 +425,7 @@ fn summarise(
     let fold_min = |v: &[&TmFrame]| v.iter().map(|f| f.f_conv_m2).fold(f64::NAN, f64::min);
     let times: Vec<f64> = frames.iter().map(|f| f.time_ms).collect();
     let (fs_max, ff_min) = (fold_max(&ok), fold_min(&ko));
+    let f_max_m2 = config.f_max_m2;
     TmReport {
         target: target.to_string(),
         scenario: scenario.to_string(),
@@ -400,6 +439,7 @@ fn summarise(
         config,
         success_rate: ok.len() as f64 / n,
         accepted_rate: frames.iter().filter(|f| f.accepted).count() as f64 / n,
+        accepted_success_rate: ok.iter().filter(|f| f.accepted).count() as f64 / n,
         false_accepts: ko.iter().filter(|f| f.accepted).count(),
         false_rejects: ok.iter().filter(|f| !f.accepted).count(),
         time_ms: MeanMax::of(&times),
@@ -417,6 +457,15 @@ fn summarise(
         fconv_failure_min: ff_min,
         fconv_failure_mean: mean(ko.iter().map(|f| f.f_conv_m2).filter(|v| v.is_finite())),
         separable: ok.is_empty() || ko.is_empty() || fs_max < ff_min,
+        unexplained_success_max: ok
+            .iter()
+            .map(|f| f.unexplained_fraction)
+            .fold(f64::NAN, f64::max),
+        unexplained_failure_min: ko
+            .iter()
+            .filter(|f| f.f_conv_m2 <= f_max_m2)
+            .map(|f| f.unexplained_fraction)
+            .fold(f64::NAN, f64::min),
         mean_points: mean(frames.iter().map(|f| f.points as f64)),
         frames,
     }
@@ -465,8 +514,12 @@ pub fn render(report: &TmReport, with_frames: bool) -> String {
         pct(report.success_rate),
     ]);
     t.row(vec![
-        format!("accepted (f_CONV ≤ {} m²)", c.f_max_m2),
+        format!("accepted (f_CONV ≤ {} m², U ≤ {})", c.f_max_m2, c.u_max),
         pct(report.accepted_rate),
+    ]);
+    t.row(vec![
+        "accepted and successful".into(),
+        pct(report.accepted_success_rate),
     ]);
     t.row(vec![
         "false accepts / false rejects".into(),
@@ -523,6 +576,14 @@ pub fn render(report: &TmReport, with_frames: bool) -> String {
     t.row(vec![
         "f_CONV separates success from failure".into(),
         report.separable.to_string(),
+    ]);
+    t.row(vec![
+        "unexplained U success max / failure min (f_CONV ok)".into(),
+        format!(
+            "{} / {}",
+            num(report.unexplained_success_max, 3),
+            num(report.unexplained_failure_min, 3)
+        ),
     ]);
     out.push_str(&t.render());
     if with_frames {
