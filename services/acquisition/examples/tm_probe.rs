@@ -120,12 +120,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 if verbose {
                     let d = o.t_sensor_target.translation - frame.truth.t_sensor_target.translation;
                     let body = frame.truth.t_sensor_target.rotation.inverse() * d;
+                    let t_inv = frame.truth.t_sensor_target.inverse();
+                    let on_array = frame
+                        .points
+                        .iter()
+                        .filter(|p| t_inv.transform(&p.position()).x < -6.5)
+                        .count();
                     println!(
-                        "frame {i}: final pos err {:.2} m, in body axes [{:.2}, {:.2}, {:.2}]",
+                        "frame {i}: final pos err {:.2} m, in body axes [{:.2}, {:.2}, {:.2}], {:.0} % of the points on the solar array",
                         d.norm(),
                         body.x,
                         body.y,
-                        body.z
+                        body.z,
+                        100.0 * on_array as f64 / frame.points.len().max(1) as f64
                     );
                     println!(
                         "frame {i}: pts {} err {e:.1} coarse {ec:.1} f_conv {:.2e} rank {} centroid-truth {:.2} m, coarse pos err {:.2} m, {:.0} ms",
