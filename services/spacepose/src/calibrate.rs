@@ -8,6 +8,11 @@
 //! log scale, since the two populations are orders of magnitude apart).
 //! Otherwise f_MAX is the largest threshold that accepts no failure, and
 //! the successes it rejects are reported.
+//!
+//! Only the failures that pass the reverse check (unexplained fraction ≤
+//! `u_max`, see `spacepose_acquisition::visibility`) count: the others are
+//! rejected whatever their f_CONV. With `--u-max 1` the check is off and
+//! every failure counts, as in seed 002.
 
 use crate::cli::ScenarioArg;
 use crate::eval::table::Table;
@@ -114,12 +119,23 @@ pub fn run(command: &CalibrateCommand) -> Result<()> {
     let report = evaluate(args.scenario, &args.options)?;
     let (ok, ko): (Vec<_>, Vec<_>) = report.frames.iter().partition(|f| f.success);
     let success: Vec<f64> = ok.iter().map(|f| f.f_conv_m2).collect();
-    let failure: Vec<f64> = ko.iter().map(|f| f.f_conv_m2).collect();
+    let u_max = report.config.u_max;
+    let failure: Vec<f64> = ko
+        .iter()
+        .filter(|f| f.unexplained_fraction <= u_max)
+        .map(|f| f.f_conv_m2)
+        .collect();
     println!(
         "f_CONV (m²) on {} / {} / seed {} / {} frames (success: error after ICP < 3°)",
         report.target, report.scenario, report.seed, report.count
     );
     println!("{}", table4(&report));
+    println!(
+        "the reverse check (U ≤ {u_max}) rejects {} of {} failures; f_MAX is set on the other {}",
+        ko.len() - failure.len(),
+        ko.len(),
+        failure.len()
+    );
     let Some(f) = recommend(&success, &failure) else {
         bail!("no successful acquisition: f_MAX cannot be derived");
     };
