@@ -28,6 +28,11 @@ use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, SMatrix, SVector, Vector3, Ve
 use spacepose_geometry::{Point, Pose, so3};
 
 type Matrix12 = SMatrix<f64, 12, 12>;
+
+/// Termination tolerance of the start pose's increment, in multiples of
+/// the end pose's thresholds (`termination_rotation_deg`,
+/// `termination_translation_m`).
+const START_TOLERANCE: f64 = 5.0;
 type Vector12 = SVector<f64, 12>;
 
 /// A Gaussian prior on the start pose `T^s = t_target_sensor` of a scan.
@@ -75,6 +80,11 @@ pub struct CtRegistration {
 struct Joint {
     h: Matrix12,
     g: Vector12,
+    /// The upper block triangle of `h`, row-major (`(0,0) (0,1) … (3,3)`),
+    /// and the blocks of `g`, while points are added: packed 3×3
+    /// accumulators instead of strided views into `h`.
+    acc_h: [Matrix3<f64>; 10],
+    acc_g: [Vector3<f64>; 4],
     cost: f64,
     squared_distance: f64,
     inliers: usize,
@@ -85,6 +95,8 @@ impl Joint {
         Self {
             h: Matrix12::zeros(),
             g: Vector12::zeros(),
+            acc_h: [Matrix3::zeros(); 10],
+            acc_g: [Vector3::zeros(); 4],
             cost: 0.0,
             squared_distance: 0.0,
             inliers: 0,
@@ -92,36 +104,45 @@ impl Joint {
     }
 
     /// Adds one residual with Jacobian blocks `[A_s B_s A_e B_e]` (rotation
-    /// and translation of each end); only the upper block triangle of `h`
-    /// is accumulated ([`Joint::mirror`] completes it).
+    /// and translation of each end) to the accumulators;
+    /// [`Joint::assemble`] then fills `h` and `g`.
     fn add(&mut self, blocks: &[Matrix3<f64>; 4], p: &Matrix3<f64>, r: &Vector3<f64>) {
         let pb = blocks.map(|b| p * b);
+        let mut k = 0;
         for (i, b) in blocks.iter().enumerate() {
-            for (j, pbj) in pb.iter().enumerate().skip(i) {
-                let mut hv = self.h.fixed_view_mut::<3, 3>(3 * i, 3 * j);
-                hv += b.tr_mul(pbj);
+            for pbj in &pb[i..] {
+                self.acc_h[k] += b.tr_mul(pbj);
+                k += 1;
             }
         }
         let pr = p * r;
-        for (i, b) in blocks.iter().enumerate() {
-            let mut gv = self.g.fixed_rows_mut::<3>(3 * i);
-            gv += b.tr_mul(&pr);
+        for (acc, b) in self.acc_g.iter_mut().zip(blocks) {
+            *acc += b.tr_mul(&pr);
         }
         self.cost += r.dot(&pr);
         self.squared_distance += r.norm_squared();
         self.inliers += 1;
     }
 
-    /// Copies the upper block triangle of `h` to the lower one.
-    fn mirror(&mut self) {
+    /// Adds the accumulated blocks to `h` (both triangles) and `g`.
+    fn assemble(&mut self) {
+        let mut k = 0;
         for i in 0..4 {
-            for j in (i + 1)..4 {
-                let upper = self.h.fixed_view::<3, 3>(3 * i, 3 * j).transpose();
-                self.h
-                    .fixed_view_mut::<3, 3>(3 * j, 3 * i)
-                    .copy_from(&upper);
+            for j in i..4 {
+                let block = self.acc_h[k];
+                k += 1;
+                let mut upper = self.h.fixed_view_mut::<3, 3>(3 * i, 3 * j);
+                upper += block;
+                if j > i {
+                    let mut lower = self.h.fixed_view_mut::<3, 3>(3 * j, 3 * i);
+                    lower += block.transpose();
+                }
             }
+            let mut gv = self.g.fixed_rows_mut::<3>(3 * i);
+            gv += self.acc_g[i];
         }
+        self.acc_h = [Matrix3::zeros(); 10];
+        self.acc_g = [Vector3::zeros(); 4];
     }
 
     /// Adds the prior `½ eᵀ Ω e` with `e = T^s ⊖ T^s₀`; `∂e/∂δ^s` is
@@ -184,40 +205,34 @@ impl Joint {
     }
 }
 
-/// Normal equations at `(start, end)` over every `stride`-th point `z`
+/// Normal equations at `(start, end)` over every point `z`
 /// with interpolation factor `u`.
 fn linearise(
     map: &NdtMap,
     points: &[(Vector3<f64>, f64)],
     start: &Pose,
     end: &Pose,
-    stride: usize,
     params: &NdtParams,
 ) -> Joint {
     let forward = Interpolation::new(start, end);
-    let backward = Interpolation::new(end, start);
     let mut joint = Joint::new();
     let phi2 = forward.phi.norm_squared();
-    for &(z, u) in points.iter().step_by(stride.max(1)) {
-        // Backward: `φ' = -φ`, factor `1 - u`, so its two coefficient sets
-        // are the forward ones swapped.
-        let (c_u, c_v) = (
-            exp_coefficients(phi2 * u * u),
-            exp_coefficients(phi2 * (1.0 - u) * (1.0 - u)),
-        );
+    for &(z, u) in points {
+        let c_u = exp_coefficients(phi2 * u * u);
+        let c_v = exp_coefficients(phi2 * (1.0 - u) * (1.0 - u));
         let le = forward.apply_with(&(start.rotation * z), u, c_u, c_v);
         let Some((k, _)) = map.nearest_cell(&le.point, params.max_distance_m, params.lookup) else {
             continue;
         };
-        let ls = backward.apply_with(&(end.rotation * z), 1.0 - u, c_v, c_u);
+        let (js_r, js_t) = forward.start_jacobian(&le, u, c_u);
         let (mean, information) = map.mean_and_information(k);
         joint.add(
-            &[ls.j_r, ls.j_t, le.j_r, le.j_t],
+            &[js_r, js_t, le.j_r, le.j_t],
             information,
             &(le.point - mean),
         );
     }
-    joint.mirror();
+    joint.assemble();
     joint
 }
 
@@ -229,9 +244,10 @@ fn split(eps: &Vector12) -> (Vector6<f64>, Vector6<f64>) {
 }
 
 /// Continuous-time NDT with the start pose free under `prior` (see the
-/// module documentation). Same termination as [`crate::register_ndt`],
-/// applied to both poses' increments; same errors as
-/// [`super::register_ct_ndt`], plus an invalid prior.
+/// module documentation). Termination: [`crate::register_ndt`]'s test on
+/// the end pose, with the start pose's increment within `START_TOLERANCE`
+/// times the thresholds; no coarse phase (`coarse_stride` is ignored).
+/// Same errors as [`super::register_ct_ndt`], plus an invalid prior.
 pub fn register_ct_ndt_free_start(
     map: &NdtMap,
     source: &[Point],
@@ -272,25 +288,18 @@ pub fn register_ct_ndt_free_start(
             && inc.translation_m < params.termination_translation_m * factor
     };
     let (mut start, mut end) = (prior.t_target_sensor, *initial_t_target_sensor_end);
-    let mut stride = params.coarse_stride.max(1);
     let (mut iterations, mut last) = (0, Increment::default());
     let mut final_joint = None;
+    // Every point from the first iteration: NDT's coarse phase (a strided
+    // subsample) left the start pose 2 cm from the full-resolution optimum
+    // along its weak directions (benchmark frame), and the fine phase spent
+    // five iterations bringing it back.
     for it in 0..params.max_iterations {
-        let mut joint = linearise(map, &points, &start, &end, stride, params);
-        if joint.inliers < 12 && stride > 1 {
-            stride = 1;
-            joint = linearise(map, &points, &start, &end, stride, params);
-        }
+        let mut joint = linearise(map, &points, &start, &end, params);
         if joint.inliers == 0 {
             return Err(no_match(it));
         }
         let data_only = (joint.cost, joint.squared_distance);
-        if stride > 1 {
-            // The prior must weigh against the same number of points.
-            let s = stride as f64;
-            joint.h *= s;
-            joint.g *= s;
-        }
         joint.add_prior(&start, prior);
         let eps = joint
             .solve(basis.as_ref())
@@ -302,20 +311,21 @@ pub fn register_ct_ndt_free_start(
         iterations = it + 1;
         let (inc_s, inc_e) = (increment_of(&eps_s), increment_of(&eps_e));
         last = inc_e;
-        let both_below = |f| below(&inc_s, f) && below(&inc_e, f);
-        if stride == 1 && both_below(1.0) {
+        // Table 1's test on the end pose, the one reported; the start pose
+        // (a nuisance held by its prior) within START_TOLERANCE times it.
+        // Both at 1× waited for twelve increments to fall below the
+        // thresholds together, while association changes keep them
+        // chattering at about 1 mm.
+        if below(&inc_e, 1.0) && below(&inc_s, START_TOLERANCE) {
             final_joint = Some(joint);
             break;
-        }
-        if stride > 1 && both_below(params.coarse_switch) {
-            stride = 1;
         }
     }
     let converged = final_joint.is_some();
     let joint = match final_joint {
         Some(j) => j,
         None => {
-            let mut j = linearise(map, &points, &start, &end, 1, params);
+            let mut j = linearise(map, &points, &start, &end, params);
             let data_only = (j.cost, j.squared_distance);
             j.add_prior(&start, prior);
             (j.cost, j.squared_distance) = data_only;

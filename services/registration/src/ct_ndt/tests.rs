@@ -142,3 +142,22 @@ fn bad_input_is_an_error_value() {
     let reg = register_ct_ndt(map(), &some_nan, &scan, &start, &start, &p).unwrap();
     assert_eq!(reg.skipped_non_finite, 2);
 }
+
+#[test]
+fn exp_coefficients_series_meet_the_closed_form() {
+    let closed = |theta2: f64| {
+        let theta = theta2.sqrt();
+        let (s, c) = theta.sin_cos();
+        (s / theta, (1.0 - c) / theta2, (theta - s) / (theta2 * theta))
+    };
+    for theta2 in [1e-6, 1e-3, 0.01, 0.039_999, 0.04, 0.1] {
+        let (a, b, c) = super::exp_coefficients(theta2);
+        let (a0, b0, c0) = closed(theta2);
+        // The closed forms of b and c lose digits to cancellation at small θ.
+        let tol = if theta2 < 1e-3 { 1e-6 } else { 1e-12 };
+        assert!((a - a0).abs() < 1e-14, "a at {theta2}");
+        assert!((b - b0).abs() < tol, "b at {theta2}");
+        assert!((c - c0).abs() < tol, "c at {theta2}: {c} vs {c0}");
+    }
+    assert_eq!(super::exp_coefficients(0.0), (1.0, 0.5, 1.0 / 6.0));
+}
