@@ -135,6 +135,8 @@ struct Linearised {
     /// The part of `j_r` from the rotation's interpolation (Eq. 15's
     /// rotation block), which the start pose's Jacobian reuses.
     rot_block: Matrix3<f64>,
+    /// `Exp((u-1)φ) = R^u (R^e)ᵀ` (`j_t = u` times it).
+    exp_v: Matrix3<f64>,
 }
 
 impl Interpolation {
@@ -207,6 +209,7 @@ impl Interpolation {
             j_r: rot_block + m_p * u,
             j_t: m * u,
             rot_block,
+            exp_v: m,
         }
     }
 
@@ -220,18 +223,33 @@ impl Interpolation {
     /// `J^s = [-p^× + (1-u) Exp(uφ) (p^s)^× - B, (1-u) Exp(uφ)]`, `B` Eq.
     /// (15)'s rotation block of the end. Cheaper than Eq. (15) with the
     /// ends swapped, which it equals.
-    #[inline]
+    #[cfg(test)]
     fn start_jacobian(
         &self,
         end: &Linearised,
         u: f64,
-        (a, b, _): (f64, f64, f64),
+        coefficients: (f64, f64, f64),
     ) -> (Matrix3<f64>, Matrix3<f64>) {
-        let (c1, c2, w) = (a * u, b * u * u, 1.0 - u);
-        let exp_u = Matrix3::identity() + self.k1 * c1 + self.k2 * c2;
+        let (a, b, _) = coefficients;
+        let exp_u = Matrix3::identity() + self.k1 * (a * u) + self.k2 * (b * u * u);
+        (
+            self.start_rotation_jacobian(end, u, coefficients),
+            exp_u * (1.0 - u),
+        )
+    }
+
+    /// The rotation block `J^s_r` of [`Interpolation::start_jacobian`]
+    /// (the free-start CT-NDT forms the translation block from `exp_v`).
+    #[inline]
+    fn start_rotation_jacobian(
+        &self,
+        end: &Linearised,
+        u: f64,
+        (a, b, _): (f64, f64, f64),
+    ) -> Matrix3<f64> {
+        let (c1, c2) = (a * u, b * u * u);
         let exp_u_ps = self.s0 + self.s1 * c1 + self.s2 * c2;
-        let j_r = exp_u_ps * w - so3::hat(&end.point) - end.rot_block;
-        (j_r, exp_u * w)
+        exp_u_ps * (1.0 - u) - so3::hat(&end.point) - end.rot_block
     }
 
     /// `-(R^u y)^× u D_exp(u Log Q) D_log(Q)`, the rotation block of

@@ -76,18 +76,67 @@ pub struct CtRegistration {
 }
 
 /// `Σ JᵀPJ`, `Σ JᵀPr`, `Σ rᵀPr`, `Σ |r|²` over the inliers for the stacked
-/// perturbation `[δ^s; δ^e]`.
+/// perturbation `[δ^s; δ^e]`, with the Jacobian blocks
+/// `[A_s, (1-u) M Q, A_e, u M]` (rotation and translation of each end;
+/// `M = Exp((u-1)φ)`, `Q = Exp(φ) = R^e (R^s)ᵀ`, so that
+/// `(1-u) Exp(uφ) = (1-u) M Q`).
+///
+/// The translation blocks share `M`, and the start's differs from the end's
+/// by the per-scan `Q` and a scalar, so per point only `P M`, `P A_s`,
+/// `P A_e` and six 3×3 products are formed (instead of four and ten for
+/// general blocks); `Q` is applied once in [`Joint::assemble`].
 struct Joint {
     h: Matrix12,
     g: Vector12,
-    /// The upper block triangle of `h`, row-major (`(0,0) (0,1) … (3,3)`),
-    /// and the blocks of `g`, while points are added: packed 3×3
-    /// accumulators instead of strided views into `h`.
-    acc_h: [Matrix3<f64>; 10],
-    acc_g: [Vector3<f64>; 4],
+    acc: Accumulators,
     cost: f64,
     squared_distance: f64,
     inliers: usize,
+}
+
+/// The per-point sums behind [`Joint`] (names: `a` the rotation blocks,
+/// `m` the translation factor `M`, `w = 1 - u`).
+#[derive(Clone, Copy)]
+struct Accumulators {
+    a_s_a_s: Matrix3<f64>,
+    a_s_a_e: Matrix3<f64>,
+    a_e_a_e: Matrix3<f64>,
+    /// `Σ w A_sᵀPM`, `Σ u A_sᵀPM`, `Σ w A_eᵀPM`, `Σ u A_eᵀPM`.
+    a_s_m_w: Matrix3<f64>,
+    a_s_m_u: Matrix3<f64>,
+    a_e_m_w: Matrix3<f64>,
+    a_e_m_u: Matrix3<f64>,
+    /// `Σ w² MᵀPM`, `Σ wu MᵀPM`, `Σ u² MᵀPM`.
+    m_m_ww: Matrix3<f64>,
+    m_m_wu: Matrix3<f64>,
+    m_m_uu: Matrix3<f64>,
+    /// `Σ A_sᵀPr`, `Σ A_eᵀPr`, `Σ w MᵀPr`, `Σ u MᵀPr`.
+    g_a_s: Vector3<f64>,
+    g_a_e: Vector3<f64>,
+    g_m_w: Vector3<f64>,
+    g_m_u: Vector3<f64>,
+}
+
+impl Accumulators {
+    fn zeros() -> Self {
+        let (z, v) = (Matrix3::zeros(), Vector3::zeros());
+        Self {
+            a_s_a_s: z,
+            a_s_a_e: z,
+            a_e_a_e: z,
+            a_s_m_w: z,
+            a_s_m_u: z,
+            a_e_m_w: z,
+            a_e_m_u: z,
+            m_m_ww: z,
+            m_m_wu: z,
+            m_m_uu: z,
+            g_a_s: v,
+            g_a_e: v,
+            g_m_w: v,
+            g_m_u: v,
+        }
+    }
 }
 
 impl Joint {
@@ -95,54 +144,86 @@ impl Joint {
         Self {
             h: Matrix12::zeros(),
             g: Vector12::zeros(),
-            acc_h: [Matrix3::zeros(); 10],
-            acc_g: [Vector3::zeros(); 4],
+            acc: Accumulators::zeros(),
             cost: 0.0,
             squared_distance: 0.0,
             inliers: 0,
         }
     }
 
-    /// Adds one residual with Jacobian blocks `[A_s B_s A_e B_e]` (rotation
-    /// and translation of each end) to the accumulators;
-    /// [`Joint::assemble`] then fills `h` and `g`.
-    fn add(&mut self, blocks: &[Matrix3<f64>; 4], p: &Matrix3<f64>, r: &Vector3<f64>) {
-        let pb = blocks.map(|b| p * b);
-        let mut k = 0;
-        for (i, b) in blocks.iter().enumerate() {
-            for pbj in &pb[i..] {
-                self.acc_h[k] += b.tr_mul(pbj);
-                k += 1;
-            }
-        }
+    /// Adds one residual `r` with information `p`, rotation blocks `a_s`,
+    /// `a_e`, translation factor `m` and interpolation factor `u` (see
+    /// [`Joint`]); [`Joint::assemble`] then fills `h` and `g`.
+    #[allow(clippy::too_many_arguments)]
+    fn add(
+        &mut self,
+        a_s: &Matrix3<f64>,
+        a_e: &Matrix3<f64>,
+        m: &Matrix3<f64>,
+        u: f64,
+        p: &Matrix3<f64>,
+        r: &Vector3<f64>,
+    ) {
+        let w = 1.0 - u;
+        let (p_a_s, p_a_e, p_m) = (p * a_s, p * a_e, p * m);
+        let acc = &mut self.acc;
+        acc.a_s_a_s += a_s.tr_mul(&p_a_s);
+        acc.a_s_a_e += a_s.tr_mul(&p_a_e);
+        acc.a_e_a_e += a_e.tr_mul(&p_a_e);
+        let x_s = a_s.tr_mul(&p_m);
+        let x_e = a_e.tr_mul(&p_m);
+        let y = m.tr_mul(&p_m);
+        acc.a_s_m_w += x_s * w;
+        acc.a_s_m_u += x_s * u;
+        acc.a_e_m_w += x_e * w;
+        acc.a_e_m_u += x_e * u;
+        acc.m_m_ww += y * (w * w);
+        acc.m_m_wu += y * (w * u);
+        acc.m_m_uu += y * (u * u);
         let pr = p * r;
-        for (acc, b) in self.acc_g.iter_mut().zip(blocks) {
-            *acc += b.tr_mul(&pr);
-        }
+        let m_pr = m.tr_mul(&pr);
+        acc.g_a_s += a_s.tr_mul(&pr);
+        acc.g_a_e += a_e.tr_mul(&pr);
+        acc.g_m_w += m_pr * w;
+        acc.g_m_u += m_pr * u;
         self.cost += r.dot(&pr);
         self.squared_distance += r.norm_squared();
         self.inliers += 1;
     }
 
-    /// Adds the accumulated blocks to `h` (both triangles) and `g`.
-    fn assemble(&mut self) {
-        let mut k = 0;
-        for i in 0..4 {
-            for j in i..4 {
-                let block = self.acc_h[k];
-                k += 1;
-                let mut upper = self.h.fixed_view_mut::<3, 3>(3 * i, 3 * j);
-                upper += block;
-                if j > i {
-                    let mut lower = self.h.fixed_view_mut::<3, 3>(3 * j, 3 * i);
-                    lower += block.transpose();
-                }
+    /// Adds the accumulated sums to `h` (both triangles) and `g`, with
+    /// `q = R^e (R^s)ᵀ` (see [`Joint`]).
+    fn assemble(&mut self, q: &Matrix3<f64>) {
+        let a = std::mem::replace(&mut self.acc, Accumulators::zeros());
+        let qt = q.transpose();
+        // Upper block triangle, in the order [A_s, B_s, A_e, B_e].
+        let upper = [
+            (0, 0, a.a_s_a_s),
+            (0, 1, a.a_s_m_w * q),
+            (0, 2, a.a_s_a_e),
+            (0, 3, a.a_s_m_u),
+            (1, 1, qt * a.m_m_ww * q),
+            (1, 2, qt * a.a_e_m_w.transpose()),
+            (1, 3, qt * a.m_m_wu),
+            (2, 2, a.a_e_a_e),
+            (2, 3, a.a_e_m_u),
+            (3, 3, a.m_m_uu),
+        ];
+        for (i, j, block) in upper {
+            let mut view = self.h.fixed_view_mut::<3, 3>(3 * i, 3 * j);
+            view += block;
+            if j > i {
+                let mut lower = self.h.fixed_view_mut::<3, 3>(3 * j, 3 * i);
+                lower += block.transpose();
             }
-            let mut gv = self.g.fixed_rows_mut::<3>(3 * i);
-            gv += self.acc_g[i];
         }
-        self.acc_h = [Matrix3::zeros(); 10];
-        self.acc_g = [Vector3::zeros(); 4];
+        for (i, block) in [a.g_a_s, qt * a.g_m_w, a.g_a_e, a.g_m_u]
+            .into_iter()
+            .enumerate()
+        {
+            let mut view = self.g.fixed_rows_mut::<3>(3 * i);
+            view += block;
+        }
     }
 
     /// Adds the prior `½ eᵀ Ω e` with `e = T^s ⊖ T^s₀`; `∂e/∂δ^s` is
@@ -224,15 +305,17 @@ fn linearise(
         let Some((k, _)) = map.nearest_cell(&le.point, params.max_distance_m, params.lookup) else {
             continue;
         };
-        let (js_r, js_t) = forward.start_jacobian(&le, u, c_u);
         let (mean, information) = map.mean_and_information(k);
         joint.add(
-            &[js_r, js_t, le.j_r, le.j_t],
+            &forward.start_rotation_jacobian(&le, u, c_u),
+            &le.j_r,
+            &le.exp_v,
+            u,
             information,
             &(le.point - mean),
         );
     }
-    joint.assemble();
+    joint.assemble(&(end.rotation * start.rotation.inverse()).into_inner());
     joint
 }
 

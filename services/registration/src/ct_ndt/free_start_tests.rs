@@ -1,7 +1,9 @@
 use super::*;
-use crate::ct_ndt::{Interpolation, ct_point_jacobian, exp_coefficients, interpolate, register_ct_ndt};
-use nalgebra::Matrix3x6;
+use crate::ct_ndt::{
+    Interpolation, ct_point_jacobian, exp_coefficients, interpolate, register_ct_ndt,
+};
 use crate::test_support::{map, perturb, rng, target, true_t_sensor_target};
+use nalgebra::Matrix3x6;
 use rand::RngExt;
 
 /// The start-pose Jacobian is Eq. (15) with the ends swapped, and equals
@@ -169,4 +171,50 @@ fn bad_prior_is_an_error_value() {
         register_ct_ndt_free_start(map(), &[], &scan, &prior, &start, &p),
         Err(RegistrationError::EmptyCloud)
     ));
+}
+
+/// `linearise`'s structured sums equal `Σ JᵀPJ` and `Σ JᵀPr` formed from
+/// the dense 3×12 Jacobian `[∂p/∂δ^s, ∂p/∂δ^e]` of every inlier.
+#[test]
+fn linearise_matches_the_dense_normal_equations() {
+    let (frame, start, end, scan) = blurred_scan();
+    let params = NdtParams::default();
+    let guess_start = perturb(&start, 0.5f64.to_radians(), 0.01, &mut rng(31));
+    let guess_end = perturb(&end, 1f64.to_radians(), 0.02, &mut rng(32));
+    let points: Vec<(Vector3<f64>, f64)> = frame
+        .iter()
+        .step_by(7)
+        .map(|p| (p.position(), scan.factor(p.t)))
+        .collect();
+    let joint = linearise(map(), &points, &guess_start, &guess_end, &params);
+    let (mut h, mut g) = (Matrix12::zeros(), Vector12::zeros());
+    let mut inliers = 0;
+    for &(z, u) in &points {
+        let p = interpolate(&guess_start, &guess_end, u).transform(&z);
+        let Some((k, _)) = map().nearest_cell(&p, params.max_distance_m, params.lookup) else {
+            continue;
+        };
+        let (mean, information) = map().mean_and_information(k);
+        let mut j = SMatrix::<f64, 3, 12>::zeros();
+        j.fixed_view_mut::<3, 6>(0, 0).copy_from(&ct_point_jacobian(
+            &guess_end,
+            &guess_start,
+            1.0 - u,
+            &z,
+        ));
+        j.fixed_view_mut::<3, 6>(0, 6).copy_from(&ct_point_jacobian(
+            &guess_start,
+            &guess_end,
+            u,
+            &z,
+        ));
+        h += j.transpose() * information * j;
+        g += j.transpose() * information * (p - mean);
+        inliers += 1;
+    }
+    assert_eq!(joint.inliers, inliers);
+    assert!(inliers > 100, "{inliers}");
+    let rel_h = (joint.h - h).norm() / h.norm();
+    let rel_g = (joint.g - g).norm() / g.norm();
+    assert!(rel_h < 1e-9 && rel_g < 1e-9, "h {rel_h}, g {rel_g}");
 }

@@ -148,7 +148,11 @@ fn exp_coefficients_series_meet_the_closed_form() {
     let closed = |theta2: f64| {
         let theta = theta2.sqrt();
         let (s, c) = theta.sin_cos();
-        (s / theta, (1.0 - c) / theta2, (theta - s) / (theta2 * theta))
+        (
+            s / theta,
+            (1.0 - c) / theta2,
+            (theta - s) / (theta2 * theta),
+        )
     };
     for theta2 in [1e-6, 1e-3, 0.01, 0.039_999, 0.04, 0.1] {
         let (a, b, c) = super::exp_coefficients(theta2);
