@@ -34,6 +34,7 @@ pub struct CoarseToFine {
 /// of full templates on the tuning runs (envisat, random, 20 m, seed 1) at
 /// about a third of the matching time.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct TemplateMatchingConfig {
     /// Δ, the Euler-angle sampling step (deg). Seed 002: 30° is the best
     /// compromise.

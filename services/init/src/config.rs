@@ -117,6 +117,32 @@ mod tests {
         assert_eq!(back, c);
     }
 
+    /// `deploy/examples/init.toml` parses, and so does its commented
+    /// `[template_matching]` example once uncommented.
+    #[test]
+    fn the_deploy_example_parses() {
+        let text = include_str!(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../deploy/examples/init.toml"
+        ));
+        let c: InitServiceConfig = toml::from_str(text).unwrap();
+        c.validate().unwrap();
+        let uncommented: String = text
+            .lines()
+            .map(|l| match l.strip_prefix("# ") {
+                Some(rest) if rest.starts_with("[template_matching") || rest.contains(" = ") => {
+                    rest.split('#').next().unwrap_or("").trim_end()
+                }
+                _ => l,
+            })
+            .collect::<Vec<_>>()
+            .join("\n");
+        let c: InitServiceConfig = toml::from_str(&uncommented).unwrap();
+        c.validate().unwrap();
+        assert_eq!(c.template_matching.u_max, 0.3);
+        assert_eq!(c.template_matching.icp.max_iterations, 40);
+    }
+
     #[test]
     fn partial_files_take_defaults_and_unknown_keys_fail() {
         let c: InitServiceConfig =
@@ -128,6 +154,18 @@ mod tests {
         );
         assert!(toml::from_str::<InitServiceConfig>("targett = \"deos\"").is_err());
         assert!(toml::from_str::<InitServiceConfig>("[state]\nretry = 1").is_err());
+        // The matcher's and its ICP's sections are partial too.
+        let c: InitServiceConfig = toml::from_str(
+            "[template_matching]\nu_max = 0.4\n[template_matching.icp]\nmax_iterations = 30\n",
+        )
+        .unwrap();
+        assert_eq!(c.template_matching.u_max, 0.4);
+        assert_eq!(c.template_matching.icp.max_iterations, 30);
+        assert_eq!(
+            c.template_matching.delta_deg,
+            TemplateMatchingConfig::default().delta_deg
+        );
+        assert!(toml::from_str::<InitServiceConfig>("[template_matching]\numax = 0.4").is_err());
     }
 
     #[test]

@@ -110,6 +110,7 @@ pub enum CellLookup {
 
 /// Gauss-Newton NDT and CT-NDT registration (seed 000 §3.1, §3.3, Table 1).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct NdtParams {
     /// Maximum distance between a transformed point and the mean of its
     /// nearest cell for the pair to enter the cost (m). Table 1: 7.5 cm.
@@ -189,6 +190,7 @@ impl NdtParams {
 
 /// Point-to-point ICP (seed 000 Table 1, ICP row).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct IcpParams {
     /// Maximum point-to-point correspondence distance (m). Table 1: 10 cm.
     pub max_distance_m: f64,
