@@ -34,7 +34,7 @@ pub use ct_ndt::{
     register_ct_ndt_free_start,
 };
 pub use error::RegistrationError;
-pub use icp::{IcpLookupStats, IcpModel, register_icp};
+pub use icp::{IcpFarLookupStats, IcpLookupStats, IcpModel, register_icp};
 pub use ndt::register_ndt;
 pub use ndt_map::{NdtCell, NdtMap, NdtMapStats};
 pub use params::{CellLookup, IcpParams, NdtMapParams, NdtParams};

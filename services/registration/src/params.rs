@@ -208,6 +208,16 @@ pub struct IcpParams {
     /// the kiddo kd-tree alone. Both give the same pairs.
     #[serde(default)]
     pub lookup: CellLookup,
+    /// Wide searches go approximate (not in seed 000): when set, and
+    /// `max_distance_m` is at least this, the iterations pair points
+    /// through the model's far lookup if it has one
+    /// ([`crate::IcpModel::with_far_lookup`]: the answer is at most about
+    /// 2 voxel edges farther than the nearest model point), and so does
+    /// the final evaluation (cost, f_CONV, information), which is then
+    /// approximate too: meant for stages whose result only feeds a
+    /// narrower one. `None` (default): exact pairs.
+    #[serde(default)]
+    pub far_lookup_from_m: Option<f64>,
 }
 
 impl Default for IcpParams {
@@ -218,6 +228,7 @@ impl Default for IcpParams {
             termination_increment: 1e-6,
             point_sigma_m: 0.01,
             lookup: CellLookup::Grid,
+            far_lookup_from_m: None,
         }
     }
 }
@@ -228,6 +239,9 @@ impl IcpParams {
         check_positive("max_distance_m", self.max_distance_m)?;
         check_positive("termination_increment", self.termination_increment)?;
         check_positive("point_sigma_m", self.point_sigma_m)?;
+        if let Some(from) = self.far_lookup_from_m {
+            check_positive("far_lookup_from_m", from)?;
+        }
         if self.max_iterations == 0 {
             return Err(RegistrationError::param("max_iterations", "must be >= 1"));
         }

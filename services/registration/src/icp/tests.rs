@@ -150,7 +150,7 @@ fn grid_lookup_is_exact_against_the_kd_tree() {
             let max2: f64 = max_distance * max_distance;
             for q in &queries {
                 let (kd_point, kd_d2) = m.nearest(q);
-                match m.nearest_within(q, max_distance, CellLookup::Grid) {
+                match m.nearest_within(q, max_distance, CellLookup::Grid, false) {
                     Some((p, d2)) => {
                         assert!(kd_d2 <= max2, "{q:?}: grid {d2}, kd-tree {kd_d2}");
                         assert!((d2 - kd_d2).abs() <= 1e-15, "{q:?}: {d2} vs {kd_d2}");
@@ -162,11 +162,68 @@ fn grid_lookup_is_exact_against_the_kd_tree() {
                         beyond += 1;
                     }
                 }
-                let (_, any_d2) = m.nearest_any(q, CellLookup::Grid);
+                let (_, any_d2) = m.nearest_any(q, CellLookup::Grid, false);
                 assert!((any_d2 - kd_d2).abs() <= 1e-15);
             }
         }
         println!("resolution {resolution}: {within} within, {beyond} beyond");
         assert!(within > 0 && beyond > 0);
     }
+}
+
+/// A wide stage through the far lookup, then the exact narrow stage, ends
+/// where exact searches end; the far lookup is used only from
+/// `far_lookup_from_m` on.
+#[test]
+fn far_lookup_wide_stage_then_exact_stage_matches_exact_searches() {
+    let far_model = IcpModel::new(&target().model())
+        .unwrap()
+        .with_far_lookup(1.0, 0.05)
+        .unwrap();
+    let stats = far_model.far_lookup_stats();
+    assert_eq!(stats.len(), 1);
+    assert!(stats[0].voxels > 0 && stats[0].resolution_m >= 0.05);
+    let truth = true_t_sensor_target().inverse();
+    let initial = perturb(&truth, 8f64.to_radians(), 0.15, &mut rng(23));
+    let wide = IcpParams {
+        max_distance_m: 0.5,
+        max_iterations: 60,
+        termination_increment: 1e-5,
+        far_lookup_from_m: Some(0.3),
+        ..Default::default()
+    };
+    let narrow = IcpParams {
+        max_iterations: 300,
+        far_lookup_from_m: Some(0.3),
+        ..Default::default()
+    };
+    let run = |m: &IcpModel| {
+        let w = register_icp(m, frame(), &initial, &wide).unwrap();
+        register_icp(m, frame(), &w.t_target_sensor, &narrow).unwrap()
+    };
+    let (approx, exact) = (run(&far_model), run(model()));
+    let (ang, d) = approx.t_target_sensor.error_to(&exact.t_target_sensor);
+    assert!(
+        ang.to_degrees() < 0.05 && d < 0.002,
+        "{}° {d} m",
+        ang.to_degrees()
+    );
+    // The narrow stage (10 cm < 0.3 m) stayed exact: same f_CONV.
+    let (fa, fe) = (approx.f_conv_m2.unwrap(), exact.f_conv_m2.unwrap());
+    assert!((fa - fe).abs() <= 0.05 * fe + 1e-9, "{fa} vs {fe}");
+    // Invalid settings are refused.
+    assert!(
+        IcpParams {
+            far_lookup_from_m: Some(f64::NAN),
+            ..Default::default()
+        }
+        .validate()
+        .is_err()
+    );
+    assert!(
+        IcpModel::new(&target().model())
+            .unwrap()
+            .with_far_lookup(-1.0, 0.1)
+            .is_err()
+    );
 }
