@@ -19,7 +19,7 @@ pub mod refine;
 pub mod template;
 pub mod visibility;
 
-pub use config::{CoarseToFine, TemplateMatchingConfig, Threads};
+pub use config::{CoarseToFine, FarLevel, FarLookup, TemplateMatchingConfig, Threads};
 pub use correlation::{Centering, Correlator, d_bor, d_bor_passes};
 pub use error::AcquisitionError;
 pub use grid::euler_grid;

@@ -84,12 +84,21 @@ impl TemplateMatcher {
         let tolerance_rad = config.unexplained_spacings
             * TemplateRenderer::new(target.clone(), &sensor, 1).ray_spacing_rad();
         let model = target.sample_surface(config.model_spacing_m, MODEL_SEED);
-        let icp_model = IcpModel::new(&model)?;
-        let stage_model = if config.stage_model_spacing_m > 0.0 {
+        let with_far = |m: IcpModel| {
+            let mut levels = config.far_lookup.iter().flat_map(|f| &f.levels);
+            levels.try_fold(m, |m, l| m.with_far_lookup(l.margin_m, l.resolution_m))
+        };
+        // Both models get the far lookup: the refinement's widest stage
+        // after screening runs on the full model.
+        let (icp_model, stage_model) = if config.stage_model_spacing_m > 0.0 {
             let coarse = target.sample_surface(config.stage_model_spacing_m, MODEL_SEED);
-            Some(IcpModel::new(&coarse)?)
+            (
+                with_far(IcpModel::new(&model)?)?,
+                Some(with_far(IcpModel::new(&coarse)?)?),
+            )
         } else {
-            None
+            // The full model serves the wide stages too.
+            (with_far(IcpModel::new(&model)?)?, None)
         };
         Ok(Self {
             target,

@@ -191,6 +191,8 @@ fn screening_follows_its_budget_and_recovers_the_pose() {
         icp_candidates: 2,
         screen_candidates: 40,
         screen_point_budget: budget,
+        // The whole cloud in each screening ICP, so the budget counts it.
+        screen_max_points: 0,
         threads: Threads::Single,
         ..TemplateMatchingConfig::default()
     };

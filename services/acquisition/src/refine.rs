@@ -57,6 +57,7 @@ pub fn refine_with_stages(
             max_distance_m: d,
             max_iterations: config.icp_stage_iterations,
             termination_increment: config.icp.termination_increment.max(1e-4),
+            far_lookup_from_m: config.far_lookup.as_ref().map(|f| f.from_m),
             ..config.icp
         };
         let r = register_icp(stage_model, cloud, &t_target_sensor, &params)?;
@@ -101,6 +102,7 @@ pub fn screen(
             max_distance_m: d,
             max_iterations: config.screen_iterations,
             termination_increment: config.icp.termination_increment.max(1e-4),
+            far_lookup_from_m: config.far_lookup.as_ref().map(|f| f.from_m),
             ..config.icp
         };
         let r = register_icp(stage_model, cloud, &t_target_sensor, &params)?;

@@ -141,6 +141,10 @@ mod tests {
         c.validate().unwrap();
         assert_eq!(c.template_matching.u_max, 0.3);
         assert_eq!(c.template_matching.icp.max_iterations, 40);
+        assert_eq!(
+            c.template_matching.far_lookup,
+            TemplateMatchingConfig::default().far_lookup
+        );
     }
 
     #[test]

@@ -22,7 +22,8 @@ use nalgebra::Rotation3;
 use rayon::prelude::*;
 use serde::Serialize;
 use spacepose_acquisition::{
-    AcquisitionOutcome, CoarseToFine, TemplateMatcher, TemplateMatchingConfig, Threads,
+    AcquisitionOutcome, CoarseToFine, FarLevel, FarLookup, TemplateMatcher, TemplateMatchingConfig,
+    Threads,
 };
 use spacepose_geometry::{Euler321, so3};
 use spacepose_lidar_sim::{Frame, LidarSimulator, SensorConfig};
@@ -116,6 +117,15 @@ pub struct TmOptions {
     /// correspondence distance²) instead of seed 002 §4.5's plain mean.
     #[arg(long)]
     pub robust_f_conv: bool,
+    /// The wide stages' approximate nearest-point lookup: `off`, or its
+    /// grids as `EDGE:MARGIN,...` in metres, finest first (default: the
+    /// library's, `0.05:0.5,0.2:3`).
+    #[arg(long)]
+    pub far_levels: Option<String>,
+    /// Narrowest stage distance (m) that uses the approximate lookup.
+    /// Default: the library's.
+    #[arg(long)]
+    pub far_from: Option<f64>,
 }
 
 /// `spacepose eval tm`.
@@ -137,9 +147,11 @@ pub struct EvalTmArgs {
 
 impl TmOptions {
     /// The library configuration.
-    pub fn matching(&self) -> TemplateMatchingConfig {
+    ///
+    /// Errors: a malformed `--far-levels`.
+    pub fn matching(&self) -> Result<TemplateMatchingConfig> {
         let d = TemplateMatchingConfig::default();
-        TemplateMatchingConfig {
+        Ok(TemplateMatchingConfig {
             delta_deg: self.delta,
             fast: self.fast,
             tau: self.tau,
@@ -164,8 +176,35 @@ impl TmOptions {
             }),
             max_correlation_points: self.max_corr_points.unwrap_or(d.max_correlation_points),
             robust_f_conv: self.robust_f_conv,
+            far_lookup: self.far_lookup()?,
             ..d
+        })
+    }
+
+    /// The far lookup: the library's, with the flags' changes.
+    fn far_lookup(&self) -> Result<Option<FarLookup>> {
+        let mut far = FarLookup::default();
+        if let Some(spec) = &self.far_levels {
+            if spec == "off" {
+                return Ok(None);
+            }
+            far.levels = spec
+                .split(',')
+                .map(|level| {
+                    let (edge, margin) = level
+                        .split_once(':')
+                        .with_context(|| format!("far level {level:?}: expected EDGE:MARGIN"))?;
+                    Ok(FarLevel {
+                        resolution_m: edge.trim().parse().context("far level edge")?,
+                        margin_m: margin.trim().parse().context("far level margin")?,
+                    })
+                })
+                .collect::<Result<_>>()?;
         }
+        if let Some(from) = self.far_from {
+            far.from_m = from;
+        }
+        Ok(Some(far))
     }
 }
 
@@ -289,7 +328,7 @@ pub fn evaluate(scenario_arg: ScenarioArg, options: &TmOptions) -> Result<TmRepo
     }
     let target = load_target(&options.target, options.scale)?;
     let sensor = SensorConfig::raster_seed002();
-    let matching = options.matching();
+    let matching = options.matching()?;
     let matcher = TemplateMatcher::new(target.clone(), sensor.clone(), matching.clone())
         .context("building the template matcher")?;
     let mut scenario_config = ScenarioConfig::default_for(scenario_arg.kind());
