@@ -36,7 +36,7 @@ pub struct FilterConfig {
     /// the filter starts at ω = 0 unless told otherwise (seed 000 §5.2).
     pub initial_sigma_w_degps: f64,
     /// Gate on the squared Mahalanobis distance of the 6-D pose innovation;
-    /// `None` accepts everything. Default χ²₆ at 99.9 % (22.46).
+    /// `None` (default) accepts everything. χ²₆ at 99.9 % is 22.46.
     pub gate_mahalanobis2: Option<f64>,
 }
 
@@ -54,7 +54,12 @@ impl Default for FilterConfig {
             initial_sigma_pos_m: 0.05,
             initial_sigma_v_mps: 0.5,
             initial_sigma_w_degps: 30.0,
-            gate_mahalanobis2: Some(22.46),
+            // Off: registration covariances are over-confident (README,
+            // "Filter gate"), and a partial `[filter]` section takes its
+            // missing keys from here, so the default must be what the
+            // services run with (a Some here used to turn the gate on in
+            // every config file that did not name it).
+            gate_mahalanobis2: None,
         }
     }
 }
@@ -113,6 +118,10 @@ mod tests {
         let partial: FilterConfig = toml::from_str("q_w = 1e-8\n").unwrap();
         assert_eq!(partial.q_w, 1e-8);
         assert_eq!(partial.q_pos, c.q_pos);
+        // Absent = off, as the deploy examples say.
+        assert_eq!(partial.gate_mahalanobis2, None);
+        let gated: FilterConfig = toml::from_str("gate_mahalanobis2 = 22.46\n").unwrap();
+        assert_eq!(gated.gate_mahalanobis2, Some(22.46));
     }
 
     #[test]

@@ -53,6 +53,8 @@ fn config() -> FilterConfig {
         q_w: 1e-10,
         sigma_rot_deg: 0.5,
         sigma_pos_m: 0.01,
+        // The χ² gate of the filter library, tested below.
+        gate_mahalanobis2: Some(22.46),
         ..Default::default()
     }
 }

@@ -67,10 +67,7 @@ pub struct FilterServiceConfig {
 impl Default for FilterServiceConfig {
     fn default() -> Self {
         Self {
-            filter: FilterConfig {
-                gate_mahalanobis2: None,
-                ..FilterConfig::default()
-            },
+            filter: FilterConfig::default(),
             state_period_ms: 500,
             selector_window: 64,
             primary: None,
@@ -411,6 +408,9 @@ mod tests {
         let text = std::fs::read_to_string(path).unwrap();
         let c: FilterServiceConfig = toml::from_str(&text).unwrap();
         c.filter.validate().unwrap();
+        // The example's [filter] section leaves the gate out: off.
+        assert_eq!(c.filter.gate_mahalanobis2, None);
+        assert_eq!(c.filter, FilterServiceConfig::default().filter);
         let d = FilterConfig::default();
         assert_eq!(c.filter.q_pos, d.q_pos);
         assert_eq!(

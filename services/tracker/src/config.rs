@@ -165,10 +165,7 @@ impl Default for TrackerConfig {
             // (`LossConfig`): the registration's information is far more
             // confident than the model errors justify, so a χ² gate on it
             // would reject good frames. The filter's own gate is therefore off.
-            filter: FilterConfig {
-                gate_mahalanobis2: None,
-                ..FilterConfig::default()
-            },
+            filter: FilterConfig::default(),
             loss: LossConfig::default(),
         }
     }
