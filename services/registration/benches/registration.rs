@@ -239,6 +239,42 @@ fn benches(c: &mut Criterion) {
     );
     report("icp/kdtree", &icp_run(&mut voxel, &icp_tree), &f.truth);
 
+    // A wide acquisition stage (2 m correspondences, 10 iterations, from
+    // 20° / 50 cm off) with exact kd-tree searches and through the far
+    // lookup of template matching (20 cm voxels within 6 m of the model).
+    let far_model = IcpModel::new(&f.model).expect("icp model");
+    let t0 = Instant::now();
+    let far_model = far_model.with_far_lookup(6.0, 0.2).expect("far lookup");
+    eprintln!(
+        "far lookup built in {:.0} ms: {:?}",
+        t0.elapsed().as_secs_f64() * 1e3,
+        far_model.far_lookup_stats()
+    );
+    let wide_start = offset(&f.truth, 20.0, 0.5);
+    let wide = IcpParams {
+        max_distance_m: 2.0,
+        max_iterations: 10,
+        termination_increment: 1e-4,
+        ..icp
+    };
+    let wide_far = IcpParams {
+        far_lookup_from_m: Some(0.2),
+        ..wide
+    };
+    let wide_run = |m: &IcpModel, p: &IcpParams| {
+        register_icp(m, &frame, &wide_start, p).expect("wide icp stage")
+    };
+    report(
+        "icp wide stage/exact",
+        &wide_run(&icp_model, &wide),
+        &f.truth,
+    );
+    report(
+        "icp wide stage/far",
+        &wide_run(&far_model, &wide_far),
+        &f.truth,
+    );
+
     {
         let cell = std::cell::RefCell::new(VoxelFilter::new(VOXEL_M).expect("voxel"));
         let v = || cell.borrow_mut();
@@ -287,6 +323,18 @@ fn benches(c: &mut Criterion) {
                         black_box(icp_run(&mut v(), &icp_tree));
                     }),
                 ),
+                (
+                    "icp wide stage exact",
+                    Box::new(|| {
+                        black_box(wide_run(&icp_model, &wide));
+                    }),
+                ),
+                (
+                    "icp wide stage far",
+                    Box::new(|| {
+                        black_box(wide_run(&far_model, &wide_far));
+                    }),
+                ),
             ],
         );
     }
@@ -332,6 +380,12 @@ fn benches(c: &mut Criterion) {
     });
     g.bench_function("model_build", |b| {
         b.iter(|| IcpModel::new(black_box(&f.model)))
+    });
+    g.bench_function("wide_stage_2m_exact", |b| {
+        b.iter(|| wide_run(&icp_model, black_box(&wide)))
+    });
+    g.bench_function("wide_stage_2m_far", |b| {
+        b.iter(|| wide_run(&far_model, black_box(&wide_far)))
     });
     g.finish();
 }

@@ -25,6 +25,7 @@ pub mod params;
 pub mod result;
 mod source;
 pub mod synthetic;
+mod voxel_box;
 
 #[cfg(test)]
 mod test_support;

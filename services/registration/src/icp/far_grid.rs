@@ -26,6 +26,7 @@
 //! (about 2 % of the distance), so an answer is within about 2 edges of
 //! the nearest point.
 
+use crate::voxel_box::VoxelBox;
 use nalgebra::Vector3;
 
 /// Marks a voxel with no point yet during the fill.
@@ -53,28 +54,14 @@ impl FarGrid {
         resolution: f64,
         max_voxels: usize,
     ) -> Self {
-        let mut lo = Vector3::repeat(f64::INFINITY);
-        let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-        for p in points {
-            lo = lo.inf(p);
-            hi = hi.sup(p);
-        }
-        let origin = lo.add_scalar(-margin);
-        let extent = (hi.add_scalar(margin) - origin).map(|e| e.max(0.0));
-        let mut h = resolution;
-        let dims = loop {
-            let d = extent.map(|e| (e / h).floor() as u64 + 1);
-            if d.x * d.y * d.z <= max_voxels as u64 {
-                break [d.x as usize, d.y as usize, d.z as usize];
-            }
-            h *= 1.1;
-        };
+        let b = VoxelBox::fit(points, margin, resolution, max_voxels);
+        let dims = b.dims.map(|d| d as usize);
         let mut grid = Self {
-            origin,
-            resolution: h,
-            inv_resolution: 1.0 / h,
+            origin: b.origin,
+            resolution: b.resolution,
+            inv_resolution: 1.0 / b.resolution,
             dims,
-            voxels: vec![NONE; dims.iter().product()],
+            voxels: vec![NONE; b.len()],
         };
         grid.seed(points);
         grid.sweep(points, true);

@@ -28,6 +28,7 @@
 //! `d_max`; beyond the grid no point is within `d_max`.
 
 use crate::kdtree::Tree3;
+use crate::voxel_box::VoxelBox;
 use kiddo::SquaredEuclidean;
 use nalgebra::Vector3;
 
@@ -72,22 +73,11 @@ impl PointGrid {
         resolution: f64,
         max_voxels: usize,
     ) -> Self {
-        let mut lo = Vector3::repeat(f64::INFINITY);
-        let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-        for p in points {
-            lo = lo.inf(p);
-            hi = hi.sup(p);
-        }
-        let lo = lo.add_scalar(-max_distance);
-        let extent = (hi.add_scalar(max_distance) - lo).map(|e| e.max(0.0));
-        let mut h = resolution;
-        let dims = loop {
-            let d = extent.map(|e| (e / h).floor() as u64 + 1);
-            if d.x * d.y * d.z <= max_voxels as u64 {
-                break [d.x as u32, d.y as u32, d.z as u32];
-            }
-            h *= 1.1;
-        };
+        let VoxelBox {
+            origin: lo,
+            resolution: h,
+            dims,
+        } = VoxelBox::fit(points, max_distance, resolution, max_voxels);
         let mut grid = Self {
             origin: [lo.x, lo.y, lo.z],
             resolution: h,

@@ -12,6 +12,7 @@
 //! `mindist(μ_j, V) ≤ |q - μ_j| ≤ d_max` and `≤ |q - μ_k| ≤ maxdist(μ_k, V)`
 //! for every `k`, so `j` is kept: the search over the candidates is exact.
 
+use crate::voxel_box::VoxelBox;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -73,22 +74,11 @@ impl LookupGrid {
         resolution: f64,
         max_voxels: usize,
     ) -> Self {
-        let mut lo = Vector3::repeat(f64::INFINITY);
-        let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-        for m in means {
-            lo = lo.inf(m);
-            hi = hi.sup(m);
-        }
-        let lo = lo.add_scalar(-max_distance);
-        let extent = (hi.add_scalar(max_distance) - lo).map(|e| e.max(0.0));
-        let mut h = resolution;
-        let dims = loop {
-            let d = extent.map(|e| (e / h).floor() as u64 + 1);
-            if d.x * d.y * d.z <= max_voxels as u64 {
-                break [d.x as u32, d.y as u32, d.z as u32];
-            }
-            h *= 1.1;
-        };
+        let VoxelBox {
+            origin: lo,
+            resolution: h,
+            dims,
+        } = VoxelBox::fit(means, max_distance, resolution, max_voxels);
         let mut grid = Self {
             origin: [lo.x, lo.y, lo.z],
             resolution: h,
