@@ -153,7 +153,9 @@ impl IcpModel {
     /// add a fine grid with a small margin first, then coarser ones with
     /// wider margins: a query beyond a fine grid's margin is at least that
     /// margin from every model point, where a coarser answer costs less
-    /// in relative terms. Queries outside every level use the kd-tree.
+    /// in relative terms. A query outside every level has no model point
+    /// within the widest margin: a search limited to that distance or less
+    /// finds none at once; a wider one uses the kd-tree.
     ///
     /// Errors: a non-finite or non-positive edge, a negative or
     /// non-finite margin.
@@ -251,7 +253,17 @@ impl IcpModel {
             return self.grid.nearest_within(q, max2);
         }
         let (m, d2) = if far {
-            self.nearest_far(q)
+            match self
+                .far
+                .iter()
+                .find_map(|grid| grid.nearest(q, &self.points))
+            {
+                Some(hit) => hit,
+                // Outside a grid whose margin reaches max_distance_m: no
+                // model point is that close (exact, and no kd-tree search).
+                None if self.far.iter().any(|g| g.margin() >= max_distance_m) => return None,
+                None => self.nearest(q),
+            }
         } else {
             self.nearest(q)
         };

@@ -41,6 +41,9 @@ pub(crate) struct FarGrid {
     inv_resolution: f64,
     dims: [usize; 3],
     voxels: Vec<u32>,
+    /// Widening of the model's bounding box (m): a query outside the grid
+    /// is farther than this from every model point.
+    margin: f64,
 }
 
 impl FarGrid {
@@ -62,12 +65,18 @@ impl FarGrid {
             inv_resolution: 1.0 / b.resolution,
             dims,
             voxels: vec![NONE; b.len()],
+            margin,
         };
         grid.seed(points);
         grid.sweep(points, true);
         grid.sweep(points, false);
         grid.sweep(points, true);
         grid
+    }
+
+    /// Widening of the model's bounding box (m).
+    pub(crate) fn margin(&self) -> f64 {
+        self.margin
     }
 
     /// Voxel edge actually used (m).

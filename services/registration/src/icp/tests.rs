@@ -227,3 +227,31 @@ fn far_lookup_wide_stage_then_exact_stage_matches_exact_searches() {
             .is_err()
     );
 }
+
+/// A query outside the far lookup has no model point within its margin:
+/// a search limited to the margin finds none without the kd-tree, and a
+/// wider one still gets the exact nearest point.
+#[test]
+fn far_lookup_answers_none_beyond_its_margin() {
+    let far_model = IcpModel::new(&target().model())
+        .unwrap()
+        .with_far_lookup(1.0, 0.1)
+        .unwrap();
+    let (lo, hi) = target().model().iter().fold(
+        (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+    );
+    let q = Vector3::new(hi.x + 3.0, 0.5 * (lo.y + hi.y), 0.5 * (lo.z + hi.z));
+    assert!(
+        far_model
+            .nearest_within(&q, 1.0, CellLookup::Grid, true)
+            .is_none()
+    );
+    let (p, d2) = far_model.nearest(&q);
+    assert!(d2 > 4.0, "{d2}");
+    let wide = far_model.nearest_within(&q, 10.0, CellLookup::Grid, true);
+    assert_eq!(wide, Some((p, d2)));
+}
