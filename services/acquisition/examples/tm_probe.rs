@@ -22,6 +22,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut effects = spacepose_lidar_sim::Effects::default();
     let mut verbose = false;
     let mut oracle = false;
+    // oracle=centroid: the nearest grid attitude, positioned as the matcher
+    // positions a template (centroid alignment, re-centred), then screened
+    // and refined like a screened candidate.
+    let mut oracle_centroid = false;
+    // oracle=vote: then moved to the mode of the translation votes.
+    let mut oracle_vote = false;
     for kv in &args[4.min(args.len())..] {
         let (k, v) = kv.split_once('=').ok_or("key=value")?;
         match k {
@@ -32,6 +38,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "screen_iters" => c.screen_iterations = v.parse()?,
             "budget" => c.screen_point_budget = v.parse()?,
             "screen_pts" => c.screen_max_points = v.parse()?,
+            "rerank" => c.screen_rerank = v.parse()?,
             "recentre" => c.recentre_iterations = v.parse()?,
             "stride" => c.template_stride = v.parse()?,
             "coarse" => {
@@ -62,7 +69,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 effects.beam_divergence = false;
             }
             "verbose" => verbose = true,
-            "oracle" => oracle = true,
+            "oracle" => {
+                oracle = true;
+                oracle_centroid = v == "centroid" || v == "vote";
+                oracle_vote = v == "vote";
+            }
             _ => return Err(format!("unknown key {k}").into()),
         }
     }
@@ -94,13 +105,63 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .iter()
                 .min_by(|a, b| so3::distance(&a.1, &truth).total_cmp(&so3::distance(&b.1, &truth)))
                 .ok_or("grid")?;
-            let t = frame.truth.t_sensor_target.translation;
-            let r = spacepose_acquisition::refine(
+            let mut t = frame.truth.t_sensor_target.translation;
+            let mut stages = m.config().icp_stages_m.clone();
+            let mut start = spacepose_geometry::Pose::new(*g, t);
+            if oracle_centroid {
+                let pos: Vec<_> = frame.points.iter().map(|p| p.position()).collect();
+                let centre = pos.iter().sum::<nalgebra::Vector3<f64>>() / pos.len() as f64;
+                let renderer =
+                    spacepose_acquisition::TemplateRenderer::new(m.target().clone(), m.sensor(), 1);
+                t = centre;
+                for _ in 0..=m.config().recentre_iterations {
+                    let tpl = renderer.render(g, &t);
+                    if tpl.len() < 3 {
+                        break;
+                    }
+                    t += centre - tpl.iter().sum::<nalgebra::Vector3<f64>>() / tpl.len() as f64;
+                }
+                if oracle_vote {
+                    let tpl = renderer.render(g, &t);
+                    let bin = m.config().translation_vote_bin_m.max(0.5);
+                    let mut scratch = spacepose_acquisition::VoteScratch::default();
+                    t += spacepose_acquisition::vote_translation(
+                        &pos,
+                        &tpl,
+                        (bin, 15.0),
+                        150,
+                        &mut scratch,
+                    )
+                    .unwrap_or_default();
+                }
+                let stride = frame
+                    .points
+                    .len()
+                    .div_ceil(m.config().screen_max_points.max(1))
+                    .max(1);
+                let sub: Vec<_> = frame.points.iter().step_by(stride).copied().collect();
+                let (p, score) = spacepose_acquisition::screen(
+                    m.stage_model(),
+                    &sub,
+                    &spacepose_geometry::Pose::new(*g, t),
+                    m.config(),
+                )?;
+                println!(
+                    "oracle frame {i}: start pos err {:.2} m, screened err {:.1} deg {:.2} m score {score:.2e}",
+                    (t - frame.truth.t_sensor_target.translation).norm(),
+                    so3::distance(&p.rotation, &truth).to_degrees(),
+                    (p.translation - frame.truth.t_sensor_target.translation).norm()
+                );
+                start = p;
+                stages = stages.split_off(stages.len().saturating_sub(1));
+            }
+            let r = spacepose_acquisition::refine_with_stages(
                 m.icp_model(),
                 m.stage_model(),
                 &frame.points,
-                &spacepose_geometry::Pose::new(*g, t),
+                &start,
                 m.config(),
+                &stages,
             );
             let e = r
                 .as_ref()

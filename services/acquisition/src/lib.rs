@@ -17,6 +17,7 @@ pub mod matcher;
 pub mod outcome;
 pub mod refine;
 pub mod template;
+pub mod translation_vote;
 pub mod visibility;
 
 pub use config::{CoarseToFine, FarLevel, FarLookup, TemplateMatchingConfig, Threads};
@@ -28,4 +29,5 @@ pub use outcome::AcquisitionOutcome;
 pub use refine::{Refined, refine, refine_with_stages, screen};
 pub use spacepose_registration::IcpParams;
 pub use template::{TemplateRenderer, template_directions};
+pub use translation_vote::{VoteScratch, vote_translation};
 pub use visibility::SensedTree;

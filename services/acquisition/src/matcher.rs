@@ -8,6 +8,7 @@ use crate::grid::euler_grid;
 use crate::outcome::AcquisitionOutcome;
 use crate::refine::{Refined, refine_with_stages, screen};
 use crate::template::TemplateRenderer;
+use crate::translation_vote::{VoteScratch, vote_translation};
 use crate::visibility::SensedTree;
 use nalgebra::{Rotation3, Vector3};
 use rayon::prelude::*;
@@ -20,6 +21,10 @@ use std::time::Instant;
 
 /// Seed of the model-cloud sampling (any fixed value: the cloud is deterministic).
 const MODEL_SEED: u64 = 0x5eed_0002;
+
+/// Points of the sensed cloud and of the template in a translation vote
+/// (150 × 150 votes).
+const VOTE_POINTS: usize = 150;
 
 /// How one template fared.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -59,6 +64,9 @@ pub struct TemplateMatcher {
     icp_model: IcpModel,
     /// The coarser model of the wide ICP stages, if configured.
     stage_model: Option<IcpModel>,
+    /// Reach of the translation vote (m): the radius of the model's
+    /// bounding box.
+    vote_reach_m: f64,
 }
 
 impl TemplateMatcher {
@@ -84,6 +92,7 @@ impl TemplateMatcher {
         let tolerance_rad = config.unexplained_spacings
             * TemplateRenderer::new(target.clone(), &sensor, 1).ray_spacing_rad();
         let model = target.sample_surface(config.model_spacing_m, MODEL_SEED);
+        let vote_reach_m = bounding_radius(&model);
         let with_far = |m: IcpModel| {
             let mut levels = config.far_lookup.iter().flat_map(|f| &f.levels);
             levels.try_fold(m, |m, l| m.with_far_lookup(l.margin_m, l.resolution_m))
@@ -110,6 +119,7 @@ impl TemplateMatcher {
             tolerance_rad,
             icp_model,
             stage_model,
+            vote_reach_m,
         })
     }
 
@@ -228,8 +238,14 @@ impl TemplateMatcher {
 
         // Template solution(s): grid attitude, origin from the centroid alignment.
         let refine_start = Instant::now();
-        let (candidates, starts, screened) =
-            self.screened_candidates(&ranked, &finite, &centre, centering);
+        let sensed_tree = SensedTree::new(&positions);
+        let (candidates, starts, screened) = self.screened_candidates(
+            &ranked,
+            &finite,
+            (&positions, &centre),
+            centering,
+            &sensed_tree,
+        );
         // After screening, the wide stages have been run: only the
         // narrowest is repeated, on the full model, before the final one.
         let stages = &self.config.icp_stages_m;
@@ -251,7 +267,6 @@ impl TemplateMatcher {
                 .map_err(|e| e.to_string())
             })
             .collect();
-        let sensed_tree = SensedTree::new(&positions);
         let unexplained: Vec<f64> = refined
             .iter()
             .map(|r| match r {
@@ -335,13 +350,15 @@ impl TemplateMatcher {
     /// The candidates to refine, `(grid index, template pose)`, the poses
     /// their refinement starts from, and how many were screened: the
     /// `icp_candidates` best distinct templates, or with screening the
-    /// `icp_candidates` best after the short ICP, from where it left them.
+    /// `icp_candidates` best after the short ICP (re-ranked by the reverse
+    /// check, see `screen_rerank`), from where it left them.
     fn screened_candidates(
         &self,
         ranked: &[(usize, f64, Vector3<f64>)],
         cloud: &[Point],
-        centre: &Vector3<f64>,
+        (positions, centre): (&[Vector3<f64>], &Vector3<f64>),
         centering: Centering,
+        sensed: &SensedTree,
     ) -> (Vec<(usize, Pose)>, Vec<Pose>, usize) {
         let c = &self.config;
         let keep = c.icp_candidates;
@@ -355,10 +372,8 @@ impl TemplateMatcher {
             .into_iter()
             .map(|(k, origin)| {
                 let r = self.grid[k].1;
-                (
-                    k,
-                    Pose::new(r, self.recentre(&r, origin, centre, centering)),
-                )
+                let origin = self.recentre(&r, origin, centre, centering);
+                (k, Pose::new(r, self.vote(&r, origin, positions)))
             })
             .collect();
         let unscreened = |t: Vec<(usize, Pose)>| {
@@ -383,6 +398,13 @@ impl TemplateMatcher {
             return unscreened(templates);
         }
         screened.sort_by(|a, b| a.0.total_cmp(&b.0));
+        if c.screen_rerank > keep && c.unexplained_weight_m2 > 0.0 {
+            screened.truncate(c.screen_rerank);
+            for s in &mut screened {
+                s.0 += c.unexplained_weight_m2 * self.unexplained(sensed, &s.2);
+            }
+            screened.sort_by(|a, b| a.0.total_cmp(&b.0));
+        }
         screened.truncate(keep);
         let chosen = screened.iter().map(|&(_, i, _)| templates[i]).collect();
         let starts = screened.iter().map(|&(_, _, p)| p).collect();
@@ -427,6 +449,33 @@ impl TemplateMatcher {
             }
         }
         origin
+    }
+
+    /// The origin of attitude `r` moved by the translation vote of its
+    /// template rendered at `origin` against the sensed `positions` (see
+    /// [`crate::translation_vote`]; unchanged when the vote is off or
+    /// finds nothing).
+    fn vote(
+        &self,
+        r: &Rotation3<f64>,
+        origin: Vector3<f64>,
+        positions: &[Vector3<f64>],
+    ) -> Vector3<f64> {
+        let bin = self.config.translation_vote_bin_m;
+        if bin <= 0.0 {
+            return origin;
+        }
+        let template = self.renderer.render(r, &origin);
+        let mut scratch = VoteScratch::default();
+        let reach = self.vote_reach_m;
+        vote_translation(
+            positions,
+            &template,
+            (bin, reach),
+            VOTE_POINTS,
+            &mut scratch,
+        )
+        .map_or(origin, |t| origin + t)
     }
 
     /// The `count` best templates, skipping any closer than
@@ -530,6 +579,17 @@ impl TemplateMatcher {
                 .collect(),
         }
     }
+}
+
+/// Half the diagonal of the bounding box of `points` (m).
+fn bounding_radius(points: &[Vector3<f64>]) -> f64 {
+    let mut lo = Vector3::repeat(f64::INFINITY);
+    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
+    for p in points {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    0.5 * (hi - lo).norm()
 }
 
 /// The scored templates sorted by C (ties by grid index).

@@ -145,6 +145,7 @@ fn single_thread_and_parallel_agree() {
         tolerance_rad: m.tolerance_rad,
         icp_model: IcpModel::new(&m.target.sample_surface(0.3, 1)).unwrap(),
         stage_model: None,
+        vote_reach_m: m.vote_reach_m,
     };
     let r = Euler321::from_degrees(-70.0, -20.0, 50.0).to_rotation();
     let cloud = frame(

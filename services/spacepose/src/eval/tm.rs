@@ -75,13 +75,22 @@ pub struct TmOptions {
     #[arg(long)]
     pub screen_candidates: Option<usize>,
     /// Screening work budget in cloud points (candidates ≤ budget /
-    /// points; 0 = no budget). Default: the library's (5000).
+    /// points; 0 = no budget). Default: the library's (9000).
     #[arg(long)]
     pub screen_budget: Option<usize>,
     /// Cloud points each screening ICP uses (0 = all). Default: the
     /// library's.
     #[arg(long)]
     pub screen_max_points: Option<usize>,
+    /// Screened poses re-ranked by the unexplained fraction before the
+    /// refinement (0 = by the screening score alone). Default: the
+    /// library's (8).
+    #[arg(long)]
+    pub screen_rerank: Option<usize>,
+    /// Bin edge (m) of the translation vote placing each candidate (0 =
+    /// off, centroid alignment only). Default: the library's (1).
+    #[arg(long)]
+    pub vote_bin: Option<f64>,
     /// Re-renderings of each candidate at its aligned origin before its
     /// ICP (0 = seed 002's centroid alignment only). Default: the
     /// library's.
@@ -166,6 +175,8 @@ impl TmOptions {
             screen_candidates: self.screen_candidates.unwrap_or(d.screen_candidates),
             screen_point_budget: self.screen_budget.unwrap_or(d.screen_point_budget),
             screen_max_points: self.screen_max_points.unwrap_or(d.screen_max_points),
+            screen_rerank: self.screen_rerank.unwrap_or(d.screen_rerank),
+            translation_vote_bin_m: self.vote_bin.unwrap_or(d.translation_vote_bin_m),
             recentre_iterations: self.recentre_iterations.unwrap_or(d.recentre_iterations),
             unexplained_weight_m2: self.unexplained_weight.unwrap_or(d.unexplained_weight_m2),
             u_max: self.u_max.unwrap_or(d.u_max),
@@ -537,8 +548,8 @@ pub fn render(report: &TmReport, with_frames: bool) -> String {
         },
         if c.screen_candidates > c.icp_candidates {
             format!(
-                "≤ {} screened (budget {} points), ",
-                c.screen_candidates, c.screen_point_budget
+                "≤ {} screened (budget {} points, best {} re-ranked by U), ",
+                c.screen_candidates, c.screen_point_budget, c.screen_rerank
             )
         } else {
             String::new()
