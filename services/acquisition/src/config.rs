@@ -184,6 +184,12 @@ pub struct TemplateMatchingConfig {
     /// failing 8 → 2 of 50 at 20 m, 9 → 6 at 30 m, 10 → 3 at 50 m;
     /// 0.5 m and 2 m bins did worse at 20 m (5 and 4).
     pub translation_vote_bin_m: f64,
+    /// Second chance of a rejected solution (not in seed 002): its refined
+    /// attitude, now within a few degrees when it was right, is placed
+    /// again by a translation vote and refined through every stage; the
+    /// better of the two by `f_CONV + w · U` is kept. Costs one refinement
+    /// on rejected frames only. Needs `translation_vote_bin_m` > 0.
+    pub revote: bool,
     /// Tolerance of the reverse check in template ray spacings (see
     /// [`crate::visibility`]): a template point is explained by a sensed
     /// point within this many spacings at its range.
@@ -261,6 +267,7 @@ impl Default for TemplateMatchingConfig {
             screen_rerank: 0,
             recentre_iterations: 2,
             translation_vote_bin_m: 1.0,
+            revote: true,
             unexplained_spacings: 1.5,
             // Tuning seed 3 (see `TemplateMatchingConfig::u_max`).
             unexplained_weight_m2: 0.05,

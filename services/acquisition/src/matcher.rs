@@ -239,7 +239,7 @@ impl TemplateMatcher {
         // Template solution(s): grid attitude, origin from the centroid alignment.
         let refine_start = Instant::now();
         let sensed_tree = SensedTree::new(&positions);
-        let (candidates, starts, screened) = self.screened_candidates(
+        let (mut candidates, starts, screened) = self.screened_candidates(
             &ranked,
             &finite,
             (&positions, &centre),
@@ -253,7 +253,7 @@ impl TemplateMatcher {
             0 => &stages[..],
             _ => &stages[stages.len().saturating_sub(1)..],
         };
-        let refined: Vec<Result<Refined, String>> = starts
+        let mut refined: Vec<Result<Refined, String>> = starts
             .iter()
             .map(|pose| {
                 refine_with_stages(
@@ -267,15 +267,30 @@ impl TemplateMatcher {
                 .map_err(|e| e.to_string())
             })
             .collect();
-        let unexplained: Vec<f64> = refined
+        let mut unexplained: Vec<f64> = refined
             .iter()
             .map(|r| match r {
                 Ok(r) => self.unexplained(&sensed_tree, &r.t_sensor_target),
                 Err(_) => 1.0,
             })
             .collect();
-        let refinement_ms = ms_since(refine_start);
         let w = self.config.unexplained_weight_m2;
+        let first_best = refined
+            .iter()
+            .zip(&unexplained)
+            .enumerate()
+            .filter_map(|(i, (r, &u))| r.as_ref().ok().map(|r| (i, r, u)))
+            .min_by(|a, b| (a.1.f_conv_m2 + w * a.2).total_cmp(&(b.1.f_conv_m2 + w * b.2)));
+        if let Some((i, r, u)) = first_best
+            && self.config.revote
+            && !self.acceptable(r.f_conv_m2, u)
+            && let Some((again, u_again)) = self.revote(r, &finite, &positions, &sensed_tree)
+        {
+            refined.push(Ok(again));
+            unexplained.push(u_again);
+            candidates.push(candidates[i]);
+        }
+        let refinement_ms = ms_since(refine_start);
         let score = |i: usize, r: &Refined| {
             if w > 0.0 {
                 r.f_conv_m2 + w * unexplained[i]
@@ -318,8 +333,6 @@ impl TemplateMatcher {
             Some((i, _)) => unexplained[i],
             None => 1.0,
         };
-        let f_conv_ok = f_conv.is_finite() && f_conv <= self.config.f_max_m2;
-        let explained = unexplained_fraction <= self.config.u_max;
         let chosen_k = candidates[chosen_rank].0;
         Ok(AcquisitionOutcome {
             t_sensor_target: pose,
@@ -329,7 +342,7 @@ impl TemplateMatcher {
             correlation_m2: c_of(chosen_rank),
             f_conv_m2: f_conv,
             unexplained_fraction,
-            accepted: f_conv_ok && explained,
+            accepted: self.acceptable(f_conv, unexplained_fraction),
             templates_generated: generated,
             templates_evaluated: evaluated,
             templates_rejected: rejected,
@@ -409,6 +422,44 @@ impl TemplateMatcher {
         let chosen = screened.iter().map(|&(_, i, _)| templates[i]).collect();
         let starts = screened.iter().map(|&(_, _, p)| p).collect();
         (chosen, starts, templates.len())
+    }
+
+    /// The acceptance test: f_CONV ≤ f_MAX (seed 002 §4.5) and the
+    /// unexplained fraction ≤ `u_max`.
+    fn acceptable(&self, f_conv_m2: f64, unexplained: f64) -> bool {
+        f_conv_m2.is_finite()
+            && f_conv_m2 <= self.config.f_max_m2
+            && unexplained <= self.config.u_max
+    }
+
+    /// The second chance of a rejected solution (see
+    /// [`TemplateMatchingConfig::revote`]): its refined attitude, placed
+    /// by a translation vote from its refined position, refined again
+    /// through every stage. `None` when the vote is off or the refinement
+    /// fails; else the result and its unexplained fraction.
+    fn revote(
+        &self,
+        rejected: &Refined,
+        cloud: &[Point],
+        positions: &[Vector3<f64>],
+        sensed: &SensedTree,
+    ) -> Option<(Refined, f64)> {
+        if self.config.translation_vote_bin_m <= 0.0 {
+            return None;
+        }
+        let r = rejected.t_sensor_target.rotation;
+        let origin = self.vote(&r, rejected.t_sensor_target.translation, positions);
+        let again = refine_with_stages(
+            &self.icp_model,
+            self.stage_model(),
+            cloud,
+            &Pose::new(r, origin),
+            &self.config,
+            &self.config.icp_stages_m,
+        )
+        .ok()?;
+        let u = self.unexplained(sensed, &again.t_sensor_target);
+        Some((again, u))
     }
 
     /// The unexplained fraction of `t_sensor_target` (see

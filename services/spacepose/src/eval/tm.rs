@@ -91,6 +91,10 @@ pub struct TmOptions {
     /// off, centroid alignment only). Default: the library's (1).
     #[arg(long)]
     pub vote_bin: Option<f64>,
+    /// No second chance (translation vote and refinement again) for a
+    /// rejected solution.
+    #[arg(long)]
+    pub no_revote: bool,
     /// Re-renderings of each candidate at its aligned origin before its
     /// ICP (0 = seed 002's centroid alignment only). Default: the
     /// library's.
@@ -177,6 +181,7 @@ impl TmOptions {
             screen_max_points: self.screen_max_points.unwrap_or(d.screen_max_points),
             screen_rerank: self.screen_rerank.unwrap_or(d.screen_rerank),
             translation_vote_bin_m: self.vote_bin.unwrap_or(d.translation_vote_bin_m),
+            revote: d.revote && !self.no_revote,
             recentre_iterations: self.recentre_iterations.unwrap_or(d.recentre_iterations),
             unexplained_weight_m2: self.unexplained_weight.unwrap_or(d.unexplained_weight_m2),
             u_max: self.u_max.unwrap_or(d.u_max),
@@ -548,8 +553,14 @@ pub fn render(report: &TmReport, with_frames: bool) -> String {
         },
         if c.screen_candidates > c.icp_candidates {
             format!(
-                "≤ {} screened (budget {} points, best {} re-ranked by U), ",
-                c.screen_candidates, c.screen_point_budget, c.screen_rerank
+                "≤ {} screened (budget {} points{}), ",
+                c.screen_candidates,
+                c.screen_point_budget,
+                if c.screen_rerank > 0 {
+                    format!(", best {} re-ranked by U", c.screen_rerank)
+                } else {
+                    String::new()
+                }
             )
         } else {
             String::new()
