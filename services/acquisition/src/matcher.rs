@@ -16,6 +16,7 @@ use spacepose_geometry::{Euler321, Point, Pose, so3};
 use spacepose_lidar_sim::{LidarSimulator, SensorConfig};
 use spacepose_registration::IcpModel;
 use spacepose_target::Target;
+use std::f64::consts::PI;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -284,11 +285,14 @@ impl TemplateMatcher {
         if let Some((i, r, u)) = first_best
             && self.config.revote
             && !self.acceptable(r.f_conv_m2, u)
-            && let Some((again, u_again)) = self.revote(r, &finite, &positions, &sensed_tree)
         {
-            refined.push(Ok(again));
-            unexplained.push(u_again);
-            candidates.push(candidates[i]);
+            for (again, u_again) in
+                self.second_chance(&r.t_sensor_target, &finite, &positions, &sensed_tree)
+            {
+                refined.push(Ok(again));
+                unexplained.push(u_again);
+                candidates.push(candidates[i]);
+            }
         }
         let refinement_ms = ms_since(refine_start);
         let score = |i: usize, r: &Refined| {
@@ -432,14 +436,34 @@ impl TemplateMatcher {
             && unexplained <= self.config.u_max
     }
 
-    /// The second chance of a rejected solution (see
-    /// [`TemplateMatchingConfig::revote`]): its refined attitude, placed
+    /// The second chance of a rejected pose (see
+    /// [`TemplateMatchingConfig::revote`] and `revote_flips`): each
+    /// attitude tried, with its result and unexplained fraction.
+    fn second_chance(
+        &self,
+        rejected: &Pose,
+        cloud: &[Point],
+        positions: &[Vector3<f64>],
+        sensed: &SensedTree,
+    ) -> Vec<(Refined, f64)> {
+        let flips = if self.config.revote_flips { 3 } else { 0 };
+        let half_turn = |a: usize| Rotation3::from_axis_angle(&Vector3::ith_axis(a), PI);
+        std::iter::once(rejected.rotation)
+            .chain((0..flips).map(|a| rejected.rotation * half_turn(a)))
+            .filter_map(|r| {
+                let pose = Pose::new(r, rejected.translation);
+                self.revote(&pose, cloud, positions, sensed)
+            })
+            .collect()
+    }
+
+    /// One attempt of the second chance: the attitude of `rejected`, placed
     /// by a translation vote from its refined position, refined again
     /// through every stage. `None` when the vote is off or the refinement
     /// fails; else the result and its unexplained fraction.
     fn revote(
         &self,
-        rejected: &Refined,
+        rejected: &Pose,
         cloud: &[Point],
         positions: &[Vector3<f64>],
         sensed: &SensedTree,
@@ -447,8 +471,8 @@ impl TemplateMatcher {
         if self.config.translation_vote_bin_m <= 0.0 {
             return None;
         }
-        let r = rejected.t_sensor_target.rotation;
-        let origin = self.vote(&r, rejected.t_sensor_target.translation, positions);
+        let r = rejected.rotation;
+        let origin = self.vote(&r, rejected.translation, positions);
         let again = refine_with_stages(
             &self.icp_model,
             self.stage_model(),

@@ -292,7 +292,9 @@ fn revote_recovers_a_slid_solution() {
     .unwrap();
     let u = m.unexplained(&sensed, &rejected.t_sensor_target);
     assert!(!m.acceptable(rejected.f_conv_m2, u), "{rejected:?} U {u}");
-    let (again, u_again) = m.revote(&rejected, &cloud, &positions, &sensed).unwrap();
+    let (again, u_again) = m
+        .revote(&rejected.t_sensor_target, &cloud, &positions, &sensed)
+        .unwrap();
     let err_m = (again.t_sensor_target.translation - truth.translation).norm();
     let err_deg = so3::distance(&again.t_sensor_target.rotation, &r).to_degrees();
     // With every sensor effect on, the direct acquisition of this frame
@@ -302,4 +304,28 @@ fn revote_recovers_a_slid_solution() {
         m.acceptable(again.f_conv_m2, u_again),
         "{again:?} U {u_again}"
     );
+}
+
+/// The second chance tries the 180° turns about the body axes: a solution
+/// flipped about body x at the true position comes back.
+#[test]
+fn second_chance_undoes_a_half_turn() {
+    let m = matcher();
+    assert!(m.config.revote && m.config.revote_flips);
+    let r = Euler321::from_degrees(40.0, 15.0, -110.0).to_rotation();
+    let truth = Pose::new(r, Vector3::new(0.2, -0.3, 20.0));
+    let cloud = frame(truth, Effects::default(), 3);
+    let positions: Vec<Vector3<f64>> = cloud.iter().map(Point::position).collect();
+    let sensed = SensedTree::new(&positions);
+    let half_turn = Rotation3::from_axis_angle(&Vector3::x_axis(), PI);
+    let flipped = Pose::new(r * half_turn, truth.translation);
+    let tries = m.second_chance(&flipped, &cloud, &positions, &sensed);
+    assert_eq!(tries.len(), 4);
+    let best = tries
+        .iter()
+        .min_by(|a, b| a.0.f_conv_m2.total_cmp(&b.0.f_conv_m2))
+        .unwrap();
+    let err_deg = so3::distance(&best.0.t_sensor_target.rotation, &r).to_degrees();
+    assert!(err_deg < 3.0, "{err_deg} deg");
+    assert!(m.acceptable(best.0.f_conv_m2, best.1), "{best:?}");
 }

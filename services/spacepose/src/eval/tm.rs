@@ -95,6 +95,10 @@ pub struct TmOptions {
     /// rejected solution.
     #[arg(long)]
     pub no_revote: bool,
+    /// The second chance does not try the rejected attitude turned 180°
+    /// about each body axis.
+    #[arg(long)]
+    pub no_revote_flips: bool,
     /// Re-renderings of each candidate at its aligned origin before its
     /// ICP (0 = seed 002's centroid alignment only). Default: the
     /// library's.
@@ -182,6 +186,7 @@ impl TmOptions {
             screen_rerank: self.screen_rerank.unwrap_or(d.screen_rerank),
             translation_vote_bin_m: self.vote_bin.unwrap_or(d.translation_vote_bin_m),
             revote: d.revote && !self.no_revote,
+            revote_flips: d.revote_flips && !self.no_revote_flips,
             recentre_iterations: self.recentre_iterations.unwrap_or(d.recentre_iterations),
             unexplained_weight_m2: self.unexplained_weight.unwrap_or(d.unexplained_weight_m2),
             u_max: self.u_max.unwrap_or(d.u_max),
