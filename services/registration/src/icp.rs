@@ -19,10 +19,12 @@ use crate::source::{check_pose, finite_positions};
 use far_grid::FarGrid;
 use kiddo::SquaredEuclidean;
 use nalgebra::{Matrix3, Rotation3, Vector3, Vector6};
+use nearest_memo::{MemoCounts, NearestMemo};
 use point_grid::PointGrid;
 use spacepose_geometry::{Point, Pose, so3};
 
 mod far_grid;
+mod nearest_memo;
 mod point_grid;
 
 /// Distance the default lookup grid of [`IcpModel::new`] is exact for (m):
@@ -223,6 +225,14 @@ impl IcpModel {
         }
     }
 
+    /// The squared distance from `q` (target body frame, m) to the nearest
+    /// model point, exactly (lookup grid when a point is within its
+    /// distance, kd-tree otherwise). For scoring a pose point by point,
+    /// e.g. a trimmed f_CONV.
+    pub fn squared_distance_m2(&self, q: &Vector3<f64>) -> f64 {
+        self.nearest_any(q, CellLookup::Grid, false).1
+    }
+
     /// The nearest model point to `q` and the squared distance (kd-tree).
     #[inline]
     fn nearest(&self, q: &Vector3<f64>) -> (Vector3<f64>, f64) {
@@ -282,6 +292,13 @@ impl IcpModel {
                 return hit;
             }
         }
+        self.nearest_beyond_grid(q, far)
+    }
+
+    /// [`IcpModel::nearest_any`]'s answer when the grid has none: the far
+    /// lookup with `far`, the kd-tree otherwise.
+    #[inline]
+    fn nearest_beyond_grid(&self, q: &Vector3<f64>, far: bool) -> (Vector3<f64>, f64) {
         if far {
             self.nearest_far(q)
         } else {
@@ -355,6 +372,29 @@ pub fn register_icp(
     initial_t_target_sensor: &Pose,
     params: &IcpParams,
 ) -> Result<Registration, RegistrationError> {
+    register_icp_counted(model, source, initial_t_target_sensor, params).0
+}
+
+/// [`register_icp`], with the lookup grid's scans and memo reuses (both
+/// zero when the grid does not serve the correspondences).
+pub(crate) fn register_icp_counted(
+    model: &IcpModel,
+    source: &[Point],
+    initial_t_target_sensor: &Pose,
+    params: &IcpParams,
+) -> (Result<Registration, RegistrationError>, MemoCounts) {
+    let mut counts = MemoCounts::default();
+    let result = icp_loop(model, source, initial_t_target_sensor, params, &mut counts);
+    (result, counts)
+}
+
+fn icp_loop(
+    model: &IcpModel,
+    source: &[Point],
+    initial_t_target_sensor: &Pose,
+    params: &IcpParams,
+    counts: &mut MemoCounts,
+) -> Result<Registration, RegistrationError> {
     params.validate()?;
     check_pose("initial_t_target_sensor", initial_t_target_sensor)?;
     let (mut points, skipped) = finite_positions(source)?;
@@ -367,6 +407,11 @@ pub fn register_icp(
         iteration,
         max_distance_m: params.max_distance_m,
     };
+    // Within the grid's distance every lookup goes through a memo per
+    // point (see `nearest_memo`: exact, and most late lookups reuse it).
+    let memoised =
+        params.lookup == CellLookup::Grid && params.max_distance_m <= model.grid.max_distance;
+    let mut memos = vec![NearestMemo::default(); if memoised { points.len() } else { 0 }];
     let mut pose = *initial_t_target_sensor;
     let (mut converged, mut iterations, mut last) = (false, 0, Increment::default());
     for it in 0..params.max_iterations {
@@ -377,11 +422,16 @@ pub fn register_icp(
             count: 0,
         };
         let rotation = pose.rotation.matrix();
-        for z in &points {
+        for (i, z) in points.iter().enumerate() {
             let x = rotation * z + pose.translation;
-            if let Some((m, _)) =
+            let hit = if memoised {
+                model
+                    .grid
+                    .nearest_within_memo(&x, max2, &mut memos[i], counts)
+            } else {
                 model.nearest_within(&x, params.max_distance_m, params.lookup, far)
-            {
+            };
+            if let Some((m, _)) = hit {
                 pairs.x_sum += x;
                 pairs.m_sum += m;
                 pairs.cross += m * x.transpose();
@@ -417,10 +467,18 @@ pub fn register_icp(
     let mut ne = NormalEquations::new();
     let mut all_d2 = 0.0;
     let identity = Matrix3::identity();
-    for z in &points {
+    let grid_max2 = model.grid.max_distance * model.grid.max_distance;
+    for (i, z) in points.iter().enumerate() {
         let rz = pose.rotation * z;
         let x = rz + pose.translation;
-        let (m, d2) = model.nearest_any(&x, params.lookup, far);
+        let (m, d2) = match memos.get_mut(i) {
+            // The grid's answer within its distance, as `nearest_any`'s.
+            Some(memo) => model
+                .grid
+                .nearest_within_memo(&x, grid_max2, memo, counts)
+                .unwrap_or_else(|| model.nearest_beyond_grid(&x, far)),
+            None => model.nearest_any(&x, params.lookup, far),
+        };
         all_d2 += d2;
         if d2 <= max2 {
             ne.add_rigid(&rz, &identity, &(x - m));

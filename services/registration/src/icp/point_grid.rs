@@ -208,23 +208,28 @@ impl PointGrid {
         mask
     }
 
-    /// The candidates of the voxel containing `q` (empty outside the grid
-    /// or for a non-finite `q`).
+    /// The index of the voxel containing `q` (`None` outside the grid or
+    /// for a non-finite `q`).
     #[inline]
-    fn candidates_at(&self, q: &Vector3<f64>) -> &[Candidate] {
+    pub(crate) fn voxel_of(&self, q: &Vector3<f64>) -> Option<usize> {
         let fx = (q.x - self.origin[0]) * self.inv_resolution;
         let fy = (q.y - self.origin[1]) * self.inv_resolution;
         let fz = (q.z - self.origin[2]) * self.inv_resolution;
         // Negated comparisons so NaN falls outside.
         if !(fx >= 0.0 && fy >= 0.0 && fz >= 0.0) {
-            return &[];
+            return None;
         }
         let (ix, iy, iz) = (fx as u64, fy as u64, fz as u64);
         let [nx, ny, nz] = self.dims.map(u64::from);
         if ix >= nx || iy >= ny || iz >= nz {
-            return &[];
+            return None;
         }
-        let v = ((iz * ny + iy) * nx + ix) as usize;
+        Some(((iz * ny + iy) * nx + ix) as usize)
+    }
+
+    /// The candidates of voxel `v`.
+    #[inline]
+    fn candidates_of(&self, v: usize) -> &[Candidate] {
         &self.candidates[self.offsets[v] as usize..self.offsets[v + 1] as usize]
     }
 
@@ -236,8 +241,9 @@ impl PointGrid {
         q: &Vector3<f64>,
         max2: f64,
     ) -> Option<(Vector3<f64>, f64)> {
+        let v = self.voxel_of(q)?;
         let mut best = (None, max2);
-        for c in self.candidates_at(q) {
+        for c in self.candidates_of(v) {
             let p = Vector3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2]));
             let d2 = (p - q).norm_squared();
             if d2 <= best.1 {
@@ -245,6 +251,30 @@ impl PointGrid {
             }
         }
         best.0.map(|p| (p, best.1))
+    }
+
+    /// Scans voxel `v` for `q` (in `v`): the nearest candidate (the last
+    /// of equals, as [`PointGrid::nearest_within`]) with its squared
+    /// distance, and the second smallest squared distance (infinite with
+    /// fewer than two candidates; equal to the first on a tie).
+    #[inline]
+    pub(crate) fn nearest_two(
+        &self,
+        v: usize,
+        q: &Vector3<f64>,
+    ) -> (Option<Vector3<f64>>, f64, f64) {
+        let (mut best, mut d1, mut d2nd) = (None, f64::INFINITY, f64::INFINITY);
+        for c in self.candidates_of(v) {
+            let p = Vector3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2]));
+            let d2 = (p - q).norm_squared();
+            if d2 <= d1 {
+                d2nd = d1;
+                (best, d1) = (Some(p), d2);
+            } else if d2 < d2nd {
+                d2nd = d2;
+            }
+        }
+        (best, d1, d2nd)
     }
 
     /// Voxel edge (m), dimensions, candidates in total and non-empty voxels.

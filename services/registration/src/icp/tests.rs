@@ -255,3 +255,70 @@ fn far_lookup_answers_none_beyond_its_margin() {
     let wide = far_model.nearest_within(&q, 10.0, CellLookup::Grid, true);
     assert_eq!(wide, Some((p, d2)));
 }
+
+/// The memoised grid lookup answers exactly as a scan of the voxel while
+/// queries drift by steps from 10 µm to 2 cm (the scale of ICP's late and
+/// early increments), and reuses its memo on the small steps.
+#[test]
+fn memoised_lookup_matches_a_scan_along_drifting_queries() {
+    let m = model();
+    let points = target().model();
+    let mut rng = rng(41);
+    let max2 = 0.1f64 * 0.1;
+    let mut counts = MemoCounts::default();
+    let mut answers = 0;
+    for walk in 0..3000 {
+        let base = points[rng.random_range(0..points.len())];
+        let mut q = base + Vector3::new(0.05, -0.03, 0.04) * rng.random_range(-1.5..1.5);
+        let step = [1e-5, 1e-4, 1e-3, 2e-2][walk % 4];
+        let mut memo = NearestMemo::default();
+        for _ in 0..30 {
+            let memoised = m.grid.nearest_within_memo(&q, max2, &mut memo, &mut counts);
+            let scanned = m.grid.nearest_within(&q, max2);
+            assert_eq!(memoised, scanned, "{q:?} (step {step} m)");
+            answers += usize::from(scanned.is_some());
+            let dir = Vector3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            );
+            q += dir * step;
+        }
+    }
+    println!("{counts:?}, {answers} answers within 10 cm of 90000 lookups");
+    assert!(answers > 30_000);
+    assert!(
+        counts.reused > 30_000 && counts.scans > 10_000,
+        "{counts:?}"
+    );
+}
+
+/// ICP through the memoised grid ends exactly where ICP through the
+/// kd-tree ends, and late iterations mostly reuse the memos.
+#[test]
+fn memoised_icp_matches_kd_tree_icp() {
+    let truth = true_t_sensor_target().inverse();
+    let initial = perturb(&truth, 3f64.to_radians(), 0.03, &mut rng(42));
+    let grid = IcpParams::default();
+    let kd = IcpParams {
+        lookup: CellLookup::KdTree,
+        ..grid
+    };
+    let (with_memo, counts) = register_icp_counted(model(), frame(), &initial, &grid);
+    let (with_memo, (by_tree, tree_counts)) = (
+        with_memo.unwrap(),
+        register_icp_counted(model(), frame(), &initial, &kd),
+    );
+    let by_tree = by_tree.unwrap();
+    let (ang, d) = with_memo.t_target_sensor.error_to(&by_tree.t_target_sensor);
+    println!(
+        "{counts:?} over {} iterations of {} points; {ang:e} rad, {d:e} m apart",
+        with_memo.iterations,
+        frame().len()
+    );
+    assert!(ang < 1e-9 && d < 1e-9);
+    assert_eq!(with_memo.iterations, by_tree.iterations);
+    assert_eq!(with_memo.inliers, by_tree.inliers);
+    assert_eq!(tree_counts, MemoCounts::default());
+    assert!(counts.reused > counts.scans, "{counts:?}");
+}
