@@ -1,6 +1,7 @@
 //! Tracker configuration: one serde struct, defaults from seed 000 Table 1.
 
 use crate::error::TrackError;
+use crate::held_rotation::HeldRotationConfig;
 use crate::mode::TrackingMode;
 use serde::{Deserialize, Serialize};
 use spacepose_filter::FilterConfig;
@@ -94,6 +95,9 @@ pub struct TrackerConfig {
     /// frame lets NDT's cells drag the roll. Equal to (or below)
     /// `ndt.min_lever_arm_m`: no hysteresis.
     pub release_lever_arm_m: f64,
+    /// The rate a held rotation follows (see [`crate::held_rotation`]):
+    /// fitted over the track before the hold instead of the filter's.
+    pub held_rotation: HeldRotationConfig,
     /// ICP parameters (Table 1).
     pub icp: IcpParams,
     /// Point noise (m) of the geometric measurement covariance: when the
@@ -157,6 +161,7 @@ impl Default for TrackerConfig {
                 ..NdtParams::default()
             },
             release_lever_arm_m: DEFAULT_RELEASE_LEVER_ARM_M,
+            held_rotation: HeldRotationConfig::default(),
             icp: IcpParams::default(),
             geometric_sigma_m: 0.0,
             ct_start: CtStart::default(),
@@ -201,6 +206,9 @@ impl TrackerConfig {
                 "release_lever_arm_m must be finite and >= 0",
                 self.release_lever_arm_m,
             ));
+        }
+        if let Some((what, v)) = self.held_rotation.invalid() {
+            return Err(bad(&format!("{what} out of its domain"), v));
         }
         if !(self.geometric_sigma_m.is_finite() && self.geometric_sigma_m >= 0.0) {
             return Err(bad(

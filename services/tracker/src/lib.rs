@@ -21,6 +21,7 @@
 
 pub mod config;
 pub mod error;
+pub mod held_rotation;
 pub mod measurement;
 pub mod mode;
 pub mod model;
@@ -33,6 +34,7 @@ pub mod wire;
 
 pub use config::{CtStart, LossConfig, TrackerConfig};
 pub use error::TrackError;
+pub use held_rotation::{HeldCorrection, HeldRotation, HeldRotationConfig};
 pub use mode::TrackingMode;
 pub use model::TrackingModel;
 pub use output::{Timings, TrackOutput};

@@ -2,6 +2,7 @@
 
 use crate::config::{CtStart, TrackerConfig};
 use crate::error::TrackError;
+use crate::held_rotation::HeldRotation;
 use crate::measurement::{covariance_sensor_target, inversion_jacobian, measurement_information};
 use crate::mode::TrackingMode;
 use crate::model::TrackingModel;
@@ -43,6 +44,8 @@ pub struct Tracker {
     /// The last registration held a rotation at the prediction (see
     /// `TrackerConfig::release_lever_arm_m`).
     holding: bool,
+    /// The track's recent poses and the rate a held rotation follows.
+    held: HeldRotation,
 }
 
 impl Tracker {
@@ -51,6 +54,7 @@ impl Tracker {
         config.validate()?;
         let filter = RelativeMotionFilter::new(config.filter.clone())?;
         let voxel = VoxelFilter::new(config.voxel_leaf_m)?;
+        let held = HeldRotation::new(config.held_rotation.clone());
         if config.mode == TrackingMode::Icp {
             // Only this mode needs it (crate::model): build it before the first frame.
             model.icp()?;
@@ -64,6 +68,7 @@ impl Tracker {
             lost: false,
             consecutive_degraded: 0,
             holding: false,
+            held,
         })
     }
 
@@ -128,6 +133,7 @@ impl Tracker {
         self.lost = false;
         self.consecutive_degraded = 0;
         self.holding = false;
+        self.held.reset();
         Ok(())
     }
 
@@ -202,6 +208,7 @@ impl Tracker {
         };
         let registration_ms = ms(reg_start);
         self.holding = registration.degenerate_directions > 0;
+        let registration = self.follow_held_rate(scan_end, registration);
         let mut out = self.assess(
             registration,
             &prediction,
@@ -209,12 +216,44 @@ impl Tracker {
             points.len(),
             cloud.len(),
         )?;
+        if let (TrackStatus::Tracking, Some(r)) = (out.status, out.registration.as_ref()) {
+            self.held.record(
+                scan_end,
+                &r.t_target_sensor,
+                r.weakest_lever_arm_m,
+                self.holding,
+            );
+        }
         out.timings = Timings {
             preprocess_ms,
             registration_ms,
             total_ms: ms(started),
         };
         Ok(out)
+    }
+
+    /// A result that held one rotation is turned about it to follow the
+    /// rate fitted before the hold (see [`crate::held_rotation`]).
+    fn follow_held_rate(&mut self, t: f64, mut registration: Registration) -> Registration {
+        if registration.degenerate_directions != 1 {
+            return registration;
+        }
+        let Some(h) = registration.geometric_information else {
+            return registration;
+        };
+        if let Some(axis) = weakest_rotation(&h)
+            && let Some(c) = self
+                .held
+                .correct(t, &mut registration.t_target_sensor, &axis, &h)
+        {
+            tracing::debug!(
+                t,
+                rate_deg_s = c.rate_rad_s.to_degrees(),
+                turn_deg = c.turn_rad.to_degrees(),
+                "held rotation follows the fitted rate"
+            );
+        }
+        registration
     }
 
     /// Motion compensation (deblur mode) and the voxel filter.
@@ -246,9 +285,14 @@ impl Tracker {
         let predicted = prediction.pose.inverse();
         let (map, c) = (&self.model.map, &self.config);
         // Hysteresis of the degeneracy handling: while a rotation is held,
-        // it is released only above `release_lever_arm_m`.
+        // it is released only above `release_lever_arm_m`; while the hold
+        // follows a fitted rate, only where the frame would count in the fit.
+        let mut release = c.release_lever_arm_m.max(c.ndt.min_lever_arm_m);
+        if self.held.following() {
+            release = release.max(self.held.min_lever_arm_m());
+        }
         let held = NdtParams {
-            min_lever_arm_m: c.release_lever_arm_m.max(c.ndt.min_lever_arm_m),
+            min_lever_arm_m: release,
             ..c.ndt
         };
         let ndt = if self.holding && c.ndt.min_lever_arm_m > 0.0 {
@@ -476,6 +520,21 @@ impl Tracker {
             },
         }
     }
+}
+
+/// The rotation axis (target frame) the geometric information `h`
+/// (`δ = [rot; trans]`) constrains least once the translation is
+/// marginalised out (the held one, as the registration's degeneracy
+/// handling finds it); `None` when `h` is not usable.
+fn weakest_rotation(h: &Matrix6<f64>) -> Option<Vector3<f64>> {
+    let h_rr = h.fixed_view::<3, 3>(0, 0).into_owned();
+    let h_rt = h.fixed_view::<3, 3>(0, 3).into_owned();
+    let h_tt_inv = h.fixed_view::<3, 3>(3, 3).into_owned().try_inverse()?;
+    let schur = h_rr - h_rt * h_tt_inv * h_rt.transpose();
+    let eig = ((schur + schur.transpose()) * 0.5).symmetric_eigen();
+    let i = eig.eigenvalues.imin();
+    let v = eig.eigenvectors.column(i).into_owned();
+    v.iter().all(|x| x.is_finite()).then_some(v)
 }
 
 fn ms(since: Instant) -> f64 {
