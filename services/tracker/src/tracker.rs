@@ -542,9 +542,32 @@ fn ms(since: Instant) -> f64 {
 }
 
 #[cfg(test)]
-mod scaling_tests {
-    use super::attitude_scaling;
-    use nalgebra::Matrix6;
+mod helper_tests {
+    use super::{attitude_scaling, weakest_rotation};
+    use nalgebra::{Matrix6, Vector3};
+
+    /// The held axis is the rotation with the least information once the
+    /// translation is marginalised out, even when the raw rotation block
+    /// alone would point elsewhere.
+    #[test]
+    fn weakest_rotation_marginalises_the_translation() {
+        let mut h = Matrix6::identity() * 100.0;
+        h[(0, 0)] = 1.0; // about x: weak
+        let axis = weakest_rotation(&h).expect("an axis");
+        assert!((axis.abs() - Vector3::x()).norm() < 1e-9, "{axis}");
+        // Rotation about y strongly coupled to translation along z: its
+        // Schur complement 100 − 99.9²/100 ≈ 0.2 is the weakest.
+        let mut h = Matrix6::identity() * 100.0;
+        h[(0, 0)] = 50.0;
+        h[(1, 5)] = 99.9;
+        h[(5, 1)] = 99.9;
+        let axis = weakest_rotation(&h).expect("an axis");
+        assert!((axis.abs() - Vector3::y()).norm() < 1e-9, "{axis}");
+        // A singular translation block gives no axis.
+        let mut h = Matrix6::identity();
+        h[(4, 4)] = 0.0;
+        assert!(weakest_rotation(&h).is_none());
+    }
 
     /// `D C D` multiplies the attitude block by `s`, the cross blocks by
     /// `√s`, and leaves the position block alone.
