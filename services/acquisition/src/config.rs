@@ -51,22 +51,45 @@ pub struct FarLevel {
 }
 
 impl Default for FarLookup {
-    /// Stages from 20 cm on, one 20 cm grid within 6 m of the model's box
-    /// (envisat: 1.8 million voxels, 7 MB, built in ~0.15 s). Tuning seed
-    /// 3 (envisat, random 20 m, one thread, 50 frames), exact → far in the
-    /// default configuration: refinement 482 → 59 ms a frame, acquisition
-    /// 534 → 111 ms mean, accepted and correct 84 % both (success 86 →
-    /// 84 %, one frame). Finer or multi-level
-    /// grids, filled lazily by kd-tree searches at the time, were slower
-    /// (10 cm within 3 m: 66 ms; 5 cm within 2 m: 81 ms; 5 cm within
-    /// 0.5 m then 20 cm within 3 m: 92 ms), none more successful.
+    /// Stages from 20 cm on; a fine grid within 0.6 m of the model's box
+    /// (5 cm asked, about 6 cm for envisat after the cap of
+    /// `spacepose_registration::MAX_GRID_VOXELS`), then a 20 cm grid within
+    /// 6 m. For envisat the grids add 3.7 s to the matcher's construction
+    /// and 65 MB.
+    ///
+    /// History:
+    /// - When the far lookup came, on tuning seed 3 (envisat, random 20 m,
+    ///   one thread, 50 frames): the 20 cm grid alone, exact → far, took the refinement
+    ///   from 482 to 59 ms a frame. Accepted and correct stayed at 84 %.
+    ///   Finer or two-level grids, then filled lazily by kd-tree searches,
+    ///   were slower and no more successful.
+    /// - Later: the 20 cm grid's answers, up to about 40 cm farther
+    ///   than the true nearest point, left the 0.5 m stage short of the
+    ///   fit. The final 10 cm stage cannot pull a pose back once ENVISAT
+    ///   has slid 20 cm or more along its long axis. Tuning seed 3, 20 cm
+    ///   grid alone → with the fine grid first:
+    ///   - accepted and correct at random 20 / 30 / 40 / 50 m: 48 / 47 /
+    ///     46 / 45 → 48 / 47 / 50 / 48 of 50;
+    ///   - ellipse: 234 → 235 of 241;
+    ///   - false accepts: 5 → 1 over the five runs;
+    ///   - ellipse successes more than 20 cm off: 32 → 18;
+    ///   - time: +20-35 ms mean.
+    ///
+    ///   10 cm within 1 m did about as well (430 accepted and correct
+    ///   against 428), with 2 false accepts.
     fn default() -> Self {
         Self {
             from_m: 0.2,
-            levels: vec![FarLevel {
-                resolution_m: 0.2,
-                margin_m: 6.0,
-            }],
+            levels: vec![
+                FarLevel {
+                    resolution_m: 0.05,
+                    margin_m: 0.6,
+                },
+                FarLevel {
+                    resolution_m: 0.2,
+                    margin_m: 6.0,
+                },
+            ],
         }
     }
 }

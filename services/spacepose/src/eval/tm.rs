@@ -136,7 +136,7 @@ pub struct TmOptions {
     pub robust_f_conv: bool,
     /// The wide stages' approximate nearest-point lookup: `off`, or its
     /// grids as `EDGE:MARGIN,...` in metres, finest first (default: the
-    /// library's, `0.05:0.5,0.2:3`).
+    /// library's, `0.05:0.6,0.2:6`).
     #[arg(long)]
     pub far_levels: Option<String>,
     /// Narrowest stage distance (m) that uses the approximate lookup.
