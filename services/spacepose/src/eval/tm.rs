@@ -7,7 +7,10 @@
 //! clutter (noise, line-of-sight error, outliers, detection losses, beam
 //! divergence, reflections, motion blur). A solution is a success when the
 //! attitude error after ICP is below 3° (§4.2), with d_sym (seed 004
-//! Eq. 14) for targets with symmetries. Acquisitions run one after the
+//! Eq. 14) for targets with symmetries. `--sensor-effects seed002` keeps
+//! only the effects seed 002 §3.2 simulates (detection, range and
+//! line-of-sight noise, 4σ range outliers), to tell what the extra effects
+//! cost. Acquisitions run one after the
 //! other, so the time is that of one acquisition with the requested
 //! threads; frames are simulated beforehand, in parallel.
 
@@ -26,7 +29,7 @@ use spacepose_acquisition::{
     Threads,
 };
 use spacepose_geometry::{Euler321, so3};
-use spacepose_lidar_sim::{Frame, LidarSimulator, SensorConfig};
+use spacepose_lidar_sim::{Effects, Frame, LidarSimulator, SensorConfig};
 use spacepose_scenario::{ScenarioConfig, build};
 use std::path::PathBuf;
 
@@ -63,6 +66,9 @@ pub struct TmOptions {
     /// 1: single-threaded template matching (fair timing); otherwise all cores.
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
+    /// Sensor effects of the simulated frames.
+    #[arg(long, value_enum, default_value_t = SensorEffects::All)]
+    pub sensor_effects: SensorEffects,
     /// Position from the trimmed centroid (seed 004) instead of the mean.
     #[arg(long)]
     pub trimmed: bool,
@@ -292,6 +298,8 @@ pub struct TmReport {
     pub range_m: f64,
     /// Seed.
     pub seed: u64,
+    /// Sensor effects of the frames.
+    pub sensor_effects: SensorEffects,
     /// Frames.
     pub count: usize,
     /// Matching configuration.
@@ -342,6 +350,33 @@ pub struct TmReport {
     pub frames: Vec<TmFrame>,
 }
 
+/// Which sensor effects the frames of `eval tm` carry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SensorEffects {
+    /// Every effect but facility clutter (the reported figures).
+    All,
+    /// Seed 002 §3.2's effects only: detection (Eq. 4), range and
+    /// line-of-sight noise, outliers at 4 σ_RANGE; no beam divergence
+    /// (mixed returns), no reflections, no motion blur.
+    Seed002,
+}
+
+impl SensorEffects {
+    fn effects(self) -> Effects {
+        match self {
+            SensorEffects::All => Effects::default(),
+            SensorEffects::Seed002 => Effects {
+                beam_divergence: false,
+                reflections: false,
+                motion_blur: false,
+                clutter: false,
+                ..Effects::all()
+            },
+        }
+    }
+}
+
 /// Runs the acquisitions of `scenario` and scores them.
 pub fn evaluate(scenario_arg: ScenarioArg, options: &TmOptions) -> Result<TmReport> {
     if !matches!(scenario_arg, ScenarioArg::Random | ScenarioArg::Ellipse) {
@@ -365,7 +400,9 @@ pub fn evaluate(scenario_arg: ScenarioArg, options: &TmOptions) -> Result<TmRepo
     scenario_config.random_frames = count.min(100_000);
     let scenario = build(&scenario_config).context("invalid scenario")?;
     let count = count.min(scenario.natural_frame_count());
-    let simulator = LidarSimulator::new(target.clone(), sensor).context("simulator")?;
+    let mut sim_sensor = sensor;
+    sim_sensor.effects = options.sensor_effects.effects();
+    let simulator = LidarSimulator::new(target.clone(), sim_sensor).context("simulator")?;
     let end_times = scenario.frame_end_times(count);
     let bar = progress_bar(count as u64, "acquiring");
     let mut frames = Vec::with_capacity(count);
@@ -495,6 +532,7 @@ fn summarise(
             f64::NAN
         },
         seed: options.seed,
+        sensor_effects: options.sensor_effects,
         count: frames.len(),
         config,
         success_rate: ok.len() as f64 / n,
@@ -535,7 +573,7 @@ fn summarise(
 pub fn render(report: &TmReport, with_frames: bool) -> String {
     let c = &report.config;
     let mut out = format!(
-        "template matching: {} / {}{} / seed {} / {} frames / Δ {}° {}/ {} / {}{} refined, mean {:.0} points\n",
+        "template matching: {} / {}{} / seed {}{} / {} frames / Δ {}° {}/ {} / {}{} refined, mean {:.0} points\n",
         report.target,
         report.scenario,
         if report.range_m.is_finite() {
@@ -544,6 +582,10 @@ pub fn render(report: &TmReport, with_frames: bool) -> String {
             String::new()
         },
         report.seed,
+        match report.sensor_effects {
+            SensorEffects::All => "",
+            SensorEffects::Seed002 => " / seed 002 sensor effects",
+        },
         report.count,
         c.delta_deg,
         if c.fast {
@@ -699,4 +741,18 @@ pub fn run(args: &EvalTmArgs) -> Result<()> {
         std::fs::write(path, json).with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SensorEffects;
+
+    #[test]
+    fn seed002_effects_are_the_papers_list() {
+        let e = SensorEffects::Seed002.effects();
+        assert!(e.range_noise && e.los_noise && e.outliers && e.detection);
+        assert!(!e.beam_divergence && !e.reflections && !e.motion_blur && !e.clutter);
+        let all = SensorEffects::All.effects();
+        assert!(all.beam_divergence && all.reflections && all.motion_blur && !all.clutter);
+    }
 }
