@@ -21,6 +21,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut kind = ScenarioKind::Random;
     let mut effects = spacepose_lidar_sim::Effects::default();
     let mut verbose = false;
+    let mut only: Option<usize> = None;
     let mut oracle = false;
     // oracle=centroid: the nearest grid attitude, positioned as the matcher
     // positions a template (centroid alignment, re-centred), then screened
@@ -69,6 +70,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 effects.beam_divergence = false;
             }
             "verbose" => verbose = true,
+            "only" => only = Some(v.parse()?),
             "oracle" => {
                 oracle = true;
                 oracle_centroid = v == "centroid" || v == "vote";
@@ -93,6 +95,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut pts = 0;
     let mut m_sum = 0.0;
     for (i, t) in scenario.frame_end_times(count).into_iter().enumerate() {
+        if only.is_some_and(|n| n != i) {
+            continue;
+        }
         let frame = sim.simulate(
             &scenario.state_at(t),
             &mut LidarSimulator::frame_rng(seed, i as u64),
@@ -208,6 +213,38 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                             .norm(),
                         o.time_ms
                     );
+                    // The second chance's vote, from the final position, at
+                    // the final attitude and at the true one.
+                    let pos: Vec<_> = frame.points.iter().map(|p| p.position()).collect();
+                    let renderer = spacepose_acquisition::TemplateRenderer::new(
+                        m.target().clone(),
+                        m.sensor(),
+                        1,
+                    );
+                    let tr = frame.truth.t_sensor_target;
+                    for (name, r) in [("final", o.t_sensor_target.rotation), ("true", tr.rotation)]
+                    {
+                        let origin = o.t_sensor_target.translation;
+                        let tpl = renderer.render(&r, &origin);
+                        let mut scratch = spacepose_acquisition::VoteScratch::default();
+                        let moved = spacepose_acquisition::vote_translation(
+                            &pos,
+                            &tpl,
+                            (m.config().translation_vote_bin_m, 21.2),
+                            150,
+                            &mut scratch,
+                        );
+                        let after = origin + moved.unwrap_or_default();
+                        let body = tr.rotation.inverse() * (after - tr.translation);
+                        println!(
+                            "frame {i}: vote at the {name} attitude: template {} pts, moved {:?}, then err [{:.2}, {:.2}, {:.2}] m",
+                            tpl.len(),
+                            moved.map(|v| (v.norm() * 100.0).round() / 100.0),
+                            body.x,
+                            body.y,
+                            body.z
+                        );
+                    }
                 }
                 t_sum += o.time_ms;
                 m_sum += o.matching_ms;

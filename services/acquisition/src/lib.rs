@@ -16,6 +16,7 @@ pub mod grid;
 pub mod matcher;
 pub mod outcome;
 pub mod refine;
+pub mod slide_search;
 pub mod template;
 pub mod translation_vote;
 pub mod visibility;

@@ -7,6 +7,7 @@ use crate::error::AcquisitionError;
 use crate::grid::euler_grid;
 use crate::outcome::AcquisitionOutcome;
 use crate::refine::{Refined, refine_with_stages, screen};
+use crate::slide_search::{SLIDE_STEP_M, principal_axis, slide_poses};
 use crate::template::TemplateRenderer;
 use crate::translation_vote::{VoteScratch, vote_translation};
 use crate::visibility::SensedTree;
@@ -454,7 +455,52 @@ impl TemplateMatcher {
                 let pose = Pose::new(r, rejected.translation);
                 self.revote(&pose, cloud, positions, sensed)
             })
+            .chain(self.slide(rejected, cloud, positions, sensed))
             .collect()
+    }
+
+    /// The slide search of the second chance (see
+    /// [`TemplateMatchingConfig::slide_reach_m`]): the rejected pose moved
+    /// along the sensed cloud's principal axis by every
+    /// [`SLIDE_STEP_M`] within the reach, each screened by a short ICP
+    /// (see [`screen`]); the best, if it scores better than the unmoved
+    /// pose, is refined from the final stage on. `None` when the search is
+    /// off, finds nothing better, or the refinement fails.
+    fn slide(
+        &self,
+        rejected: &Pose,
+        cloud: &[Point],
+        positions: &[Vector3<f64>],
+        sensed: &SensedTree,
+    ) -> Option<(Refined, f64)> {
+        let reach = self.config.slide_reach_m;
+        if reach <= 0.0 {
+            return None;
+        }
+        let subsample = strided(cloud, self.config.screen_max_points);
+        let axis = principal_axis(positions)?;
+        let screened =
+            |pose: &Pose| screen(self.stage_model(), &subsample, pose, &self.config).ok();
+        let (_, unmoved) = screened(rejected)?;
+        let (start, score) = slide_poses(rejected, &axis, reach, SLIDE_STEP_M)
+            .iter()
+            .filter_map(screened)
+            .min_by(|a, b| a.1.total_cmp(&b.1))?;
+        if score >= unmoved {
+            return None;
+        }
+        let stages = &self.config.icp_stages_m;
+        let again = refine_with_stages(
+            &self.icp_model,
+            self.stage_model(),
+            cloud,
+            &start,
+            &self.config,
+            &stages[stages.len().saturating_sub(1)..],
+        )
+        .ok()?;
+        let u = self.unexplained(sensed, &again.t_sensor_target);
+        Some((again, u))
     }
 
     /// One attempt of the second chance: the attitude of `rejected`, placed

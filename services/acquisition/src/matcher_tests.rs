@@ -329,3 +329,52 @@ fn second_chance_undoes_a_half_turn() {
     assert!(err_deg < 3.0, "{err_deg} deg");
     assert!(m.acceptable(best.0.f_conv_m2, best.1), "{best:?}");
 }
+
+/// The slide search: ENVISAT seen from the solar array's end (seed 7
+/// ellipse frame 152, 26 m, most points on the array at grazing incidence).
+/// A solution with the right attitude slid 5 m along the long axis is a
+/// minimum of every ICP stage and of the translation vote; the search along
+/// the cloud's principal axis brings it back.
+#[test]
+fn slide_search_recovers_an_end_on_slide() {
+    let m = matcher();
+    assert!(m.config.slide_reach_m >= 5.0);
+    let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+        -0.481330353,
+        0.520174055,
+        0.419619487,
+        0.567150359,
+    ));
+    let r = q.to_rotation_matrix();
+    let truth = Pose::new(r, Vector3::new(-0.117947464, -0.069450179, 26.046641804));
+    let cloud = frame(truth, Effects::default(), 5);
+    assert!(cloud.len() > 400, "{}", cloud.len());
+    let positions: Vec<Vector3<f64>> = cloud.iter().map(Point::position).collect();
+    let sensed = SensedTree::new(&positions);
+    let slid = Pose::new(r, truth.translation + r * Vector3::new(-5.0, 0.0, 0.0));
+    let rejected = refine_with_stages(
+        &m.icp_model,
+        m.stage_model(),
+        &cloud,
+        &slid,
+        &m.config,
+        &[0.5],
+    )
+    .unwrap();
+    let off = |p: &Pose| (p.translation - truth.translation).norm();
+    assert!(off(&rejected.t_sensor_target) > 3.0, "{rejected:?}");
+    let u = m.unexplained(&sensed, &rejected.t_sensor_target);
+    assert!(!m.acceptable(rejected.f_conv_m2, u), "{rejected:?} U {u}");
+    let (again, u_again) = m
+        .slide(&rejected.t_sensor_target, &cloud, &positions, &sensed)
+        .unwrap();
+    let err_deg = so3::distance(&again.t_sensor_target.rotation, &r).to_degrees();
+    assert!(
+        off(&again.t_sensor_target) < 0.5 && err_deg < 3.0,
+        "{again:?}"
+    );
+    assert!(
+        m.acceptable(again.f_conv_m2, u_again),
+        "{again:?} U {u_again}"
+    );
+}

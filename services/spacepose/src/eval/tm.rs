@@ -105,6 +105,10 @@ pub struct TmOptions {
     /// about each body axis.
     #[arg(long)]
     pub no_revote_flips: bool,
+    /// Reach (m) of the second chance's slide search along the sensed
+    /// cloud's principal axis (0 = off). Default: the library's.
+    #[arg(long)]
+    pub slide_reach: Option<f64>,
     /// Re-renderings of each candidate at its aligned origin before its
     /// ICP (0 = seed 002's centroid alignment only). Default: the
     /// library's.
@@ -193,6 +197,7 @@ impl TmOptions {
             translation_vote_bin_m: self.vote_bin.unwrap_or(d.translation_vote_bin_m),
             revote: d.revote && !self.no_revote,
             revote_flips: d.revote_flips && !self.no_revote_flips,
+            slide_reach_m: self.slide_reach.unwrap_or(d.slide_reach_m),
             recentre_iterations: self.recentre_iterations.unwrap_or(d.recentre_iterations),
             unexplained_weight_m2: self.unexplained_weight.unwrap_or(d.unexplained_weight_m2),
             u_max: self.u_max.unwrap_or(d.u_max),
