@@ -315,7 +315,8 @@ pub struct EvalTrackingArgs {
     pub warmup: usize,
     /// NDT degeneracy handling: rotations with a smaller lever arm are
     /// held at the prediction (`NdtParams::min_lever_arm_m`, m; 0 = the
-    /// paper). Default: the tracker's.
+    /// paper), in every mode (`ndt` mode has its own default,
+    /// `TrackerConfig::ndt_mode_min_lever_arm_m`). Default: the tracker's.
     #[arg(long)]
     pub min_lever_arm_m: Option<f64>,
     /// Point noise (m) of the geometric measurement covariance fed to the

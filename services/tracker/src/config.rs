@@ -95,6 +95,14 @@ pub struct TrackerConfig {
     /// frame lets NDT's cells drag the roll. Equal to (or below)
     /// `ndt.min_lever_arm_m`: no hysteresis.
     pub release_lever_arm_m: f64,
+    /// `ndt.min_lever_arm_m` in `ndt` mode (m). That mode has no motion
+    /// model: its guess is the previous pose, so at a lever arm of 3.5-5 cm
+    /// (the approach to the 3 m hold) NDT's cells drag the roll frame after
+    /// frame, where the other modes start from the filter's prediction.
+    /// Tuned on slow-spin seed 1 (`ndt` max 9.93° at 3.5 cm, 3.37° at 4.5
+    /// and 5 cm, diverged at 5.5 cm, the held rotation's own
+    /// `min_lever_arm_m`, at frame 1046); 5 cm.
+    pub ndt_mode_min_lever_arm_m: f64,
     /// The rate a held rotation follows (see [`crate::held_rotation`]):
     /// fitted over the track before the hold instead of the filter's.
     pub held_rotation: HeldRotationConfig,
@@ -147,6 +155,9 @@ pub enum CtStart {
 /// 6.70° with 4.5 or 6 cm; deblur unchanged at 2.01°).
 pub const DEFAULT_RELEASE_LEVER_ARM_M: f64 = 0.045;
 
+/// Default [`TrackerConfig::ndt_mode_min_lever_arm_m`] (m).
+pub const DEFAULT_NDT_MODE_MIN_LEVER_ARM_M: f64 = 0.05;
+
 /// Default `ndt.min_lever_arm_m` of the tracker (m); see
 /// [`TrackerConfig::ndt`].
 pub const DEFAULT_MIN_LEVER_ARM_M: f64 = 0.035;
@@ -161,6 +172,7 @@ impl Default for TrackerConfig {
                 ..NdtParams::default()
             },
             release_lever_arm_m: DEFAULT_RELEASE_LEVER_ARM_M,
+            ndt_mode_min_lever_arm_m: DEFAULT_NDT_MODE_MIN_LEVER_ARM_M,
             held_rotation: HeldRotationConfig::default(),
             icp: IcpParams::default(),
             geometric_sigma_m: 0.0,
@@ -185,6 +197,16 @@ impl TrackerConfig {
         }
     }
 
+    /// The degeneracy handling's threshold in the current mode:
+    /// [`TrackerConfig::ndt_mode_min_lever_arm_m`] in `ndt` mode,
+    /// `ndt.min_lever_arm_m` otherwise.
+    pub fn min_lever_arm_m(&self) -> f64 {
+        match self.mode {
+            TrackingMode::Ndt => self.ndt_mode_min_lever_arm_m,
+            _ => self.ndt.min_lever_arm_m,
+        }
+    }
+
     /// Checks every value; NaN fails.
     pub fn validate(&self) -> Result<(), TrackError> {
         let bad = |what: &str, v: f64| TrackError::InvalidConfig(format!("{what} = {v}"));
@@ -200,6 +222,10 @@ impl TrackerConfig {
                 "ct_ndt_attitude_covariance_scale must be finite and > 0",
                 s,
             ));
+        }
+        let n = self.ndt_mode_min_lever_arm_m;
+        if !(n.is_finite() && n >= 0.0) {
+            return Err(bad("ndt_mode_min_lever_arm_m must be finite and >= 0", n));
         }
         if !(self.release_lever_arm_m.is_finite() && self.release_lever_arm_m >= 0.0) {
             return Err(bad(
@@ -277,5 +303,24 @@ mod tests {
         let mut c = TrackerConfig::default();
         c.loss.min_points = 0;
         assert!(c.validate().is_err());
+        for v in [f64::NAN, -0.01, f64::INFINITY] {
+            let c = TrackerConfig {
+                ndt_mode_min_lever_arm_m: v,
+                ..TrackerConfig::default()
+            };
+            assert!(c.validate().is_err(), "{v}");
+        }
+    }
+
+    #[test]
+    fn ndt_mode_has_its_own_hold_threshold() {
+        let ndt = TrackerConfig::with_mode(TrackingMode::Ndt);
+        assert_eq!(ndt.min_lever_arm_m(), DEFAULT_NDT_MODE_MIN_LEVER_ARM_M);
+        for mode in [TrackingMode::Deblur, TrackingMode::CtNdt, TrackingMode::Icp] {
+            let c = TrackerConfig::with_mode(mode);
+            assert_eq!(c.min_lever_arm_m(), DEFAULT_MIN_LEVER_ARM_M);
+        }
+        // Below the held rotation's fit threshold (see the field's doc).
+        assert!(DEFAULT_NDT_MODE_MIN_LEVER_ARM_M < ndt.held_rotation.min_lever_arm_m);
     }
 }

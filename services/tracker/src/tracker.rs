@@ -287,18 +287,22 @@ impl Tracker {
         // Hysteresis of the degeneracy handling: while a rotation is held,
         // it is released only above `release_lever_arm_m`; while the hold
         // follows a fitted rate, only where the frame would count in the fit.
-        let mut release = c.release_lever_arm_m.max(c.ndt.min_lever_arm_m);
+        let base = NdtParams {
+            min_lever_arm_m: c.min_lever_arm_m(),
+            ..c.ndt
+        };
+        let mut release = c.release_lever_arm_m.max(base.min_lever_arm_m);
         if self.held.following() {
             release = release.max(self.held.min_lever_arm_m());
         }
         let held = NdtParams {
             min_lever_arm_m: release,
-            ..c.ndt
+            ..base
         };
-        let ndt = if self.holding && c.ndt.min_lever_arm_m > 0.0 {
+        let ndt = if self.holding && base.min_lever_arm_m > 0.0 {
             &held
         } else {
-            &c.ndt
+            &base
         };
         Ok(match c.mode {
             TrackingMode::Ndt => register_ndt(map, cloud, &previous, ndt)?,

@@ -63,7 +63,8 @@ pub struct EvalConfig {
     pub target: (String, f64),
     /// Frames excluded from the converged statistics.
     pub warmup: usize,
-    /// Overrides the tracker's NDT `min_lever_arm_m`.
+    /// Overrides the tracker's NDT `min_lever_arm_m` (and
+    /// `ndt_mode_min_lever_arm_m`, its value in `ndt` mode).
     pub min_lever_arm_m: Option<f64>,
     /// Overrides the tracker's `geometric_sigma_m`.
     pub geometric_sigma_m: Option<f64>,
@@ -256,6 +257,7 @@ fn start_trackers(
             };
             if let Some(lever) = config.min_lever_arm_m {
                 tracker_config.ndt.min_lever_arm_m = lever;
+                tracker_config.ndt_mode_min_lever_arm_m = lever;
             }
             if let Some(sigma) = config.geometric_sigma_m {
                 tracker_config.geometric_sigma_m = sigma;
