@@ -6,7 +6,7 @@
 mod common;
 
 use common::{free_port, unique_names};
-use spacepose_bus::{Bridge, Bus, Route, WakeReason, ZenohConfig, open_zenoh};
+use spacepose_bus::{Bridge, BridgeStats, Bus, Route, WakeReason, ZenohConfig, open_zenoh};
 use spacepose_geometry::Point;
 use spacepose_messages::{
     CloudHeader, CloudMsg, Command, CommandKind, Name, PoseEstimate, SCHEMA_VERSION, Topic, decode,
@@ -130,16 +130,34 @@ fn clouds_are_rate_limited() {
         .collect();
     // Wait until the link carries a first frame.
     let deadline = Instant::now() + Duration::from_secs(10);
+    let mut warm_up_sent = 0;
     let first = loop {
         assert!(Instant::now() < deadline, "no cloud on zenoh within 10 s");
         clouds.send(CloudHeader::new(0, 0.0, 0.1), &points).unwrap();
+        warm_up_sent += 1;
         if let Some(s) = cloud_in.recv_timeout(Duration::from_millis(600)).unwrap() {
             break decode::<CloudMsg>(&s.payload().to_bytes()).unwrap();
         }
     };
     assert_eq!(first.points, points);
+    // Let the worker account for the warm-up frames it will see (a late one
+    // would otherwise count among the 20 below): wait until its counts have
+    // stood still for 300 ms. Frames sent before it subscribed never come.
+    let total = |s: &BridgeStats| s.forwarded_to_zenoh + s.rate_limited + s.errors;
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let mut before = bridge.stats();
+    let mut still_since = Instant::now();
+    while total(&before) < warm_up_sent && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(20));
+        let now = bridge.stats();
+        if total(&now) != total(&before) {
+            still_since = Instant::now();
+        } else if still_since.elapsed() > Duration::from_millis(300) {
+            break;
+        }
+        before = now;
+    }
     // 20 frames at ~50 Hz for 0.4 s: a 2 Hz limit lets at most 2 through.
-    let before = bridge.stats();
     for seq in 1..=20 {
         clouds
             .send(CloudHeader::new(seq, 0.0, 0.1), &points)
