@@ -282,10 +282,12 @@ impl TemplateMatcher {
             .zip(&unexplained)
             .enumerate()
             .filter_map(|(i, (r, &u))| r.as_ref().ok().map(|r| (i, r, u)))
-            .min_by(|a, b| (a.1.f_conv_m2 + w * a.2).total_cmp(&(b.1.f_conv_m2 + w * b.2)));
+            .min_by(|a, b| (a.1.msd_all_m2 + w * a.2).total_cmp(&(b.1.msd_all_m2 + w * b.2)));
         if let Some((i, r, u)) = first_best
             && self.config.revote
-            && !self.acceptable(r.f_conv_m2, u)
+            // The uncapped f_CONV decides whether to try again: a flip can
+            // fit most points and still leave a few far off.
+            && !self.acceptable(r.msd_all_m2, u)
         {
             for (again, u_again) in
                 self.second_chance(&r.t_sensor_target, &finite, &positions, &sensed_tree)
@@ -298,9 +300,9 @@ impl TemplateMatcher {
         let refinement_ms = ms_since(refine_start);
         let score = |i: usize, r: &Refined| {
             if w > 0.0 {
-                r.f_conv_m2 + w * unexplained[i]
+                r.msd_all_m2 + w * unexplained[i]
             } else {
-                r.f_conv_m2
+                r.msd_all_m2
             }
         };
         let best = refined

@@ -21,7 +21,7 @@ use crate::common::load_target;
 use crate::sim_cmd::progress_bar;
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use nalgebra::Rotation3;
+use nalgebra::{Rotation3, UnitQuaternion};
 use rayon::prelude::*;
 use serde::Serialize;
 use spacepose_acquisition::{
@@ -105,6 +105,10 @@ pub struct TmOptions {
     /// about each body axis.
     #[arg(long)]
     pub no_revote_flips: bool,
+    /// Per-point cap (m) of f_CONV (0 = seed 002's uncapped mean).
+    /// Default: the library's.
+    #[arg(long)]
+    pub f_conv_cap: Option<f64>,
     /// Reach (m) of the second chance's slide search along the sensed
     /// cloud's principal axis (0 = off). Default: the library's.
     #[arg(long)]
@@ -208,6 +212,7 @@ impl TmOptions {
             }),
             max_correlation_points: self.max_corr_points.unwrap_or(d.max_correlation_points),
             robust_f_conv: self.robust_f_conv,
+            f_conv_cap_m: self.f_conv_cap.unwrap_or(d.f_conv_cap_m),
             far_lookup: self.far_lookup()?,
             ..d
         })
@@ -279,6 +284,10 @@ pub struct TmFrame {
     pub templates_evaluated: usize,
     /// The acquisition error, if any (counted as a failure).
     pub error: Option<String>,
+    /// The solution, target body → sensor: `[x, y, z, qw, qx, qy, qz]`
+    /// (m; unit quaternion); `None` without one. For diagnostics against
+    /// the frames `spacepose sim` writes for the same scenario and seed.
+    pub t_sensor_target: Option<[f64; 7]>,
 }
 
 /// Means of the template counts.
@@ -478,6 +487,7 @@ fn score(
         templates_generated: 0,
         templates_evaluated: 0,
         error: None,
+        t_sensor_target: None,
     };
     let out = match result {
         Ok(out) => out,
@@ -504,6 +514,11 @@ fn score(
     rec.templates_generated = out.templates_generated;
     rec.templates_evaluated = out.templates_evaluated;
     rec.error = out.refinement_error;
+    let (p, q) = (
+        out.t_sensor_target.translation,
+        UnitQuaternion::from_rotation_matrix(&r),
+    );
+    rec.t_sensor_target = Some([p.x, p.y, p.z, q.w, q.i, q.j, q.k]);
     rec
 }
 
