@@ -4,6 +4,7 @@
 
 use crate::{TrackStatus, Tracker, TrackerConfig, TrackingMode, TrackingModel};
 use nalgebra::Vector3;
+use spacepose_geometry::Pose;
 use spacepose_lidar_sim::{LidarSimulator, SensorConfig};
 use spacepose_registration::NdtMapParams;
 use spacepose_scenario::{ScenarioConfig, ScenarioKind, build};
@@ -30,6 +31,22 @@ fn run(
     frames: usize,
     seed: u64,
 ) -> Vec<Vec<(TrackStatus, f64, f64)>> {
+    let configs: Vec<_> = modes.iter().map(|&m| TrackerConfig::with_mode(m)).collect();
+    run_configs(kind, &configs, first, frames, seed)
+        .into_iter()
+        .map(|res| res.into_iter().map(|(s, a, p, _)| (s, a, p)).collect())
+        .collect()
+}
+
+/// [`run`] with one tracker per configuration; also returns each output's
+/// `t_sensor_target`.
+fn run_configs(
+    kind: ScenarioKind,
+    configs: &[TrackerConfig],
+    first: usize,
+    frames: usize,
+    seed: u64,
+) -> Vec<Vec<(TrackStatus, f64, f64, Pose)>> {
     let (target, model) = deos();
     let mut config = ScenarioConfig::default_for(kind);
     config.seed = seed;
@@ -39,10 +56,10 @@ fn run(
     let sim = LidarSimulator::new(target.clone(), sensor).unwrap();
     let ends = scenario.frame_end_times(first + frames);
     let t0 = ends[first] - 1.0;
-    let mut trackers: Vec<Tracker> = modes
+    let mut trackers: Vec<Tracker> = configs
         .iter()
-        .map(|&m| {
-            let mut t = Tracker::new(TrackerConfig::with_mode(m), model.clone()).unwrap();
+        .map(|c| {
+            let mut t = Tracker::new(c.clone(), model.clone()).unwrap();
             t.initialize(
                 t0,
                 &scenario.pose_at(t0),
@@ -53,7 +70,7 @@ fn run(
             t
         })
         .collect();
-    let mut results = vec![Vec::new(); modes.len()];
+    let mut results = vec![Vec::new(); configs.len()];
     for (k, &t_end) in ends.iter().enumerate().skip(first) {
         let frame = sim.simulate(
             &scenario.state_at(t_end),
@@ -64,7 +81,7 @@ fn run(
                 .process(&frame.points, frame.scan_start, frame.scan_end)
                 .unwrap();
             let (ang, pos) = out.t_sensor_target.error_to(&frame.truth.t_sensor_target);
-            res.push((out.status, ang.to_degrees(), pos));
+            res.push((out.status, ang.to_degrees(), pos, out.t_sensor_target));
         }
     }
     results
@@ -100,4 +117,33 @@ fn deblur_and_ct_ndt_track_a_10_degps_tumble() {
             );
         }
     }
+}
+
+/// Below `ct_ndt_min_points`, `ct-ndt` fits one pose to the cloud
+/// compensated by the filter's prediction and fuses it unscaled: it then
+/// follows `deblur` exactly, frame for frame, where CT-NDT's two poses
+/// differ from it by degrees while the filter learns the tumble's rate.
+#[test]
+fn sparse_ct_ndt_frames_fit_one_compensated_pose() {
+    let ct = TrackerConfig::with_mode(TrackingMode::CtNdt);
+    let sparse_ct = TrackerConfig {
+        ct_ndt_min_points: usize::MAX,
+        ..ct.clone()
+    };
+    let deblur = TrackerConfig::with_mode(TrackingMode::Deblur);
+    let res = run_configs(ScenarioKind::Tumbling, &[deblur, sparse_ct, ct], 0, 8, 12);
+    let gap = |a: &Pose, b: &Pose| {
+        let (ang, pos) = a.error_to(b);
+        (ang.to_degrees(), pos)
+    };
+    let mut ct_gap_max = 0.0f64;
+    for (k, ((d, s), c)) in res[0].iter().zip(&res[1]).zip(&res[2]).enumerate() {
+        let (ang, pos) = gap(&s.3, &d.3);
+        assert!(
+            ang < 1e-9 && pos < 1e-9,
+            "frame {k}: {ang:.3e} deg, {pos:.3e} m"
+        );
+        ct_gap_max = ct_gap_max.max(gap(&c.3, &d.3).0);
+    }
+    assert!(ct_gap_max > 1.0, "CT-NDT itself: {ct_gap_max:.2} deg");
 }

@@ -180,7 +180,7 @@ impl Tracker {
             ));
         }
         let pre = Instant::now();
-        let cloud = match self.preprocess(points, &prediction) {
+        let (cloud, compensated) = match self.preprocess(points, &prediction) {
             Ok(c) => c,
             Err(e) => {
                 return Ok(self.declare_lost(&prediction, points.len(), e.to_string(), started));
@@ -200,7 +200,11 @@ impl Tracker {
             return Ok(out);
         }
         let reg_start = Instant::now();
-        let registration = match self.register(&cloud, &prediction, &last, scan_start, scan_end) {
+        let scan = ScanTimes {
+            start_s: scan_start,
+            end_s: scan_end,
+        };
+        let registration = match self.register(&cloud, compensated, &prediction, &last, &scan) {
             Ok(r) => r,
             Err(e) => {
                 return Ok(self.declare_lost(&prediction, points.len(), e.to_string(), started));
@@ -209,13 +213,8 @@ impl Tracker {
         let registration_ms = ms(reg_start);
         self.holding = registration.degenerate_directions > 0;
         let registration = self.follow_held_rate(scan_end, registration);
-        let mut out = self.assess(
-            registration,
-            &prediction,
-            scan_end,
-            points.len(),
-            cloud.len(),
-        )?;
+        let counts = (points.len(), cloud.len());
+        let mut out = self.assess(registration, compensated, &prediction, scan_end, counts)?;
         if let (TrackStatus::Tracking, Some(r)) = (out.status, out.registration.as_ref()) {
             self.held.record(
                 scan_end,
@@ -256,30 +255,47 @@ impl Tracker {
         registration
     }
 
-    /// Motion compensation (deblur mode) and the voxel filter.
+    /// Motion compensation (Eq. 12) and the voxel filter. Returns the cloud
+    /// and whether it was compensated: always in `deblur` mode, and in
+    /// `ct-ndt` mode when the frame has fewer than
+    /// `TrackerConfig::ct_ndt_min_points` points after the voxel filter
+    /// (then one pose is fitted, see [`TrackerConfig::ct_ndt_min_points`]).
+    /// The raw points are compensated before the voxel filter: the
+    /// scanner's rosette revisits a voxel at different times, so a voxel's
+    /// mean timestamp does not compensate its mean point.
     fn preprocess(
         &mut self,
         points: &[Point],
         prediction: &Prediction,
-    ) -> Result<Vec<Point>, TrackError> {
-        if self.config.mode == TrackingMode::Deblur {
-            // One copy of the finite points, compensated in place (Eq. 12,
-            // one sin_cos per point about the fixed axis R ω).
-            let mut finite: Vec<Point> = points.iter().copied().filter(Point::is_finite).collect();
-            MotionCompensation::from_prediction(prediction)?.compensate_in_place(&mut finite)?;
-            return Ok(self.voxel.filter(&finite)?.points);
+    ) -> Result<(Vec<Point>, bool), TrackError> {
+        match self.config.mode {
+            TrackingMode::Deblur => {}
+            TrackingMode::CtNdt => {
+                let cloud = self.voxel.filter(points)?.points;
+                if cloud.len() >= self.config.ct_ndt_min_points {
+                    return Ok((cloud, false));
+                }
+            }
+            TrackingMode::Ndt | TrackingMode::Icp => {
+                return Ok((self.voxel.filter(points)?.points, false));
+            }
         }
-        Ok(self.voxel.filter(points)?.points)
+        // One copy of the finite points, compensated in place (Eq. 12, one
+        // sin_cos per point about the fixed axis R ω).
+        let mut finite: Vec<Point> = points.iter().copied().filter(Point::is_finite).collect();
+        MotionCompensation::from_prediction(prediction)?.compensate_in_place(&mut finite)?;
+        Ok((self.voxel.filter(&finite)?.points, true))
     }
 
-    /// Runs the registration of the current mode from its initial guess.
+    /// Runs the registration of the current mode from its initial guess;
+    /// `compensated` as [`Tracker::preprocess`] returned it.
     fn register(
         &self,
         cloud: &[Point],
+        compensated: bool,
         prediction: &Prediction,
         last: &LastPose,
-        scan_start: f64,
-        scan_end: f64,
+        scan: &ScanTimes,
     ) -> Result<Registration, TrackError> {
         let previous = last.t_sensor_target.inverse();
         let predicted = prediction.pose.inverse();
@@ -308,22 +324,18 @@ impl Tracker {
             TrackingMode::Ndt => register_ndt(map, cloud, &previous, ndt)?,
             TrackingMode::Icp => register_icp(self.model.icp()?, cloud, &previous, &c.icp)?,
             TrackingMode::Deblur => register_ndt(map, cloud, &predicted, ndt)?,
-            TrackingMode::CtNdt => {
-                let scan = ScanTimes {
-                    start_s: scan_start,
-                    end_s: scan_end,
-                };
-                match c.ct_start {
-                    CtStart::Fixed => {
-                        let start = self.fixed_ct_start(last, scan_start)?;
-                        register_ct_ndt(map, cloud, &scan, &start, &predicted, ndt)?
-                    }
-                    CtStart::FilterPrior => {
-                        let prior = self.ct_start_prior(scan_start)?;
-                        register_ct_ndt_free_start(map, cloud, &scan, &prior, &predicted, ndt)?.end
-                    }
+            // A sparse frame, compensated by the prediction: one pose.
+            TrackingMode::CtNdt if compensated => register_ndt(map, cloud, &predicted, ndt)?,
+            TrackingMode::CtNdt => match c.ct_start {
+                CtStart::Fixed => {
+                    let start = self.fixed_ct_start(last, scan.start_s)?;
+                    register_ct_ndt(map, cloud, scan, &start, &predicted, ndt)?
                 }
-            }
+                CtStart::FilterPrior => {
+                    let prior = self.ct_start_prior(scan.start_s)?;
+                    register_ct_ndt_free_start(map, cloud, scan, &prior, &predicted, ndt)?.end
+                }
+            },
         })
     }
 
@@ -374,20 +386,29 @@ impl Tracker {
     }
 
     /// The measurement covariance `[rot; trans]` with its attitude inflated
-    /// by [`Tracker::ct_attitude_scale`] (`D C D`, `D = diag(√s I, I)`).
-    fn attitude_scaled(&self, c: Matrix6<f64>) -> Matrix6<f64> {
+    /// by [`Tracker::ct_attitude_scale`] (`D C D`, `D = diag(√s I, I)`),
+    /// unless the cloud was `compensated`: a sparse `ct-ndt` frame fitted
+    /// as one pose is fused as `deblur` fuses it, since the inflation is for
+    /// CT-NDT's extrapolated end pose (with it, the filter lost seed 1's
+    /// tumble in a sparse stretch, its rate hardly corrected).
+    fn attitude_scaled(&self, c: Matrix6<f64>, compensated: bool) -> Matrix6<f64> {
+        if compensated {
+            return c;
+        }
         let d = attitude_scaling(self.ct_attitude_scale());
         d * c * d
     }
 
     /// Quality and consistency checks, filter update, status.
+    /// `(points_in, points_used)` are the frame's point counts before and
+    /// after pre-processing.
     fn assess(
         &mut self,
         registration: Registration,
+        compensated: bool,
         prediction: &Prediction,
         t: f64,
-        points_in: usize,
-        points_used: usize,
+        (points_in, points_used): (usize, usize),
     ) -> Result<TrackOutput, TrackError> {
         let measured = registration.t_sensor_target();
         let innovation_rot_deg =
@@ -395,7 +416,7 @@ impl Tracker {
         let innovation_pos_m = (measured.translation - prediction.pose.translation).norm();
         let information = measurement_information(&registration, self.config.geometric_sigma_m);
         let covariance = covariance_sensor_target(&registration.t_target_sensor, &information)
-            .map(|c| self.attitude_scaled(c));
+            .map(|c| self.attitude_scaled(c, compensated));
         let mut reasons = self.quality_issues(&registration);
         let l = &self.config.loss;
         if innovation_rot_deg > l.max_innovation_rot_deg
