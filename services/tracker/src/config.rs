@@ -137,10 +137,10 @@ pub struct TrackerConfig {
     /// the paper; 0 = always CT-NDT). Why: CT-NDT fits 12 degrees of freedom
     /// to the same points, and on a sparse frame the end pose, extrapolated
     /// from the scan's last points, wanders the most (see the README,
-    /// "ct-ndt on sparse frames"). Tuned on seed 1 over 0, 3000 and 5000:
-    /// slow-spin max 3.22, 2.03, 2.95° (mean over its 58 frames below 3000
-    /// points 0.85, 0.58, 0.61°); tumbling max 2.27, 2.01, 1.89° (45 such
-    /// frames: 0.94, 0.68, 0.67°). 3000, the lower max on the slow spin.
+    /// "ct-ndt on sparse frames"). Tuned on seed 1 over 0, 3000, 4000 and
+    /// 5000: slow-spin max 3.22, 2.03, 2.01, 2.95° (mean over its frames
+    /// below 3000 points 0.85, 0.58, 0.55, 0.61°); tumbling max 2.27, 2.01,
+    /// 1.81, 1.89° (0.94, 0.68, 0.68, 0.67°). 4000, the lowest max on both.
     pub ct_ndt_min_points: usize,
     /// Relative-motion filter tuning.
     pub filter: FilterConfig,
@@ -168,7 +168,7 @@ pub enum CtStart {
 pub const DEFAULT_RELEASE_LEVER_ARM_M: f64 = 0.045;
 
 /// Default [`TrackerConfig::ct_ndt_min_points`].
-pub const DEFAULT_CT_NDT_MIN_POINTS: usize = 3000;
+pub const DEFAULT_CT_NDT_MIN_POINTS: usize = 4000;
 
 /// Default [`TrackerConfig::ndt_mode_min_lever_arm_m`] (m).
 pub const DEFAULT_NDT_MODE_MIN_LEVER_ARM_M: f64 = 0.05;
