@@ -15,8 +15,9 @@ use nalgebra::Vector3;
 use spacepose_geometry::{Euler321, Point, Pose, VoxelFilter, so3};
 use spacepose_lidar_sim::{LidarSimulator, SensorConfig};
 use spacepose_registration::{
-    CellLookup, IcpModel, IcpParams, NdtMap, NdtMapParams, NdtParams, Registration, ScanTimes,
-    StartPrior, register_ct_ndt, register_ct_ndt_free_start, register_icp, register_ndt,
+    CellLookup, CtPriors, DisplacementPrior, IcpModel, IcpParams, NdtMap, NdtMapParams, NdtParams,
+    RatePrior, Registration, ScanTimes, StartPrior, register_ct_ndt, register_ct_ndt_free_start,
+    register_ct_ndt_with_priors, register_icp, register_ndt,
 };
 use spacepose_scenario::TruthState;
 use spacepose_target::Target;
@@ -211,6 +212,33 @@ fn benches(c: &mut Criterion) {
             .expect("ct free start")
             .end
     };
+    // The tracker's default since the motion prior: no start prior, the
+    // turn and displacement over the scan 0.1° / 5 mm off the truth under
+    // σ 0.1° / 5 mm (the filter's velocity errors over a 1 s scan).
+    let true_turn = f.truth.rotation * f.truth_start.rotation.inverse();
+    let origin = |p: &Pose| -(p.rotation.inverse() * p.translation);
+    let (s_turn, s_disp) = (0.1f64.to_radians(), 0.005);
+    let motion = CtPriors {
+        start: StartPrior {
+            t_target_sensor: f.truth_start,
+            information: nalgebra::Matrix6::zeros(),
+        },
+        rate: Some(RatePrior {
+            turn: so3::exp(&Vector3::new(0.0, s_turn, 0.0)) * true_turn,
+            information: nalgebra::Matrix3::identity() / (s_turn * s_turn),
+        }),
+        displacement: Some(DisplacementPrior {
+            displacement_m: origin(&f.truth) - origin(&f.truth_start)
+                + Vector3::new(s_disp, 0.0, 0.0),
+            information: nalgebra::Matrix3::identity() / (s_disp * s_disp),
+        }),
+    };
+    let ct_motion_run = |voxel: &mut VoxelFilter| {
+        let cloud = filtered(voxel, &f.raw_blurred);
+        register_ct_ndt_with_priors(&map, &cloud, &f.scan, &motion, &guess_end, &grid)
+            .expect("ct motion prior")
+            .end
+    };
     let icp_run = |voxel: &mut VoxelFilter, p: &IcpParams| {
         let cloud = filtered(voxel, &f.raw);
         register_icp(&icp_model, &cloud, &initial, p).expect("icp")
@@ -223,6 +251,11 @@ fn benches(c: &mut Criterion) {
     report(
         "ct_ndt free start (end pose)",
         &ct_free_run(&mut voxel),
+        &f.truth,
+    );
+    report(
+        "ct_ndt motion prior (end pose)",
+        &ct_motion_run(&mut voxel),
         &f.truth,
     );
     let from_truth = register_ct_ndt(&map, &blurred, &f.scan, &f.truth_start, &f.truth, &grid);
@@ -312,6 +345,12 @@ fn benches(c: &mut Criterion) {
                     }),
                 ),
                 (
+                    "ct_ndt motion prior",
+                    Box::new(|| {
+                        black_box(ct_motion_run(&mut v()));
+                    }),
+                ),
+                (
                     "icp voxel+grid",
                     Box::new(|| {
                         black_box(icp_run(&mut v(), &icp));
@@ -367,6 +406,9 @@ fn benches(c: &mut Criterion) {
     });
     g.bench_function("free_start_voxel_grid_10dps_blur", |b| {
         b.iter(|| ct_free_run(black_box(&mut voxel)))
+    });
+    g.bench_function("motion_prior_voxel_grid_10dps_blur", |b| {
+        b.iter(|| ct_motion_run(black_box(&mut voxel)))
     });
     g.finish();
 

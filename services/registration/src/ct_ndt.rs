@@ -13,8 +13,14 @@ use crate::source::{check_pose, position_is_finite};
 use nalgebra::{Matrix3, Matrix3x6, Vector3};
 use spacepose_geometry::{Point, Pose, so3};
 
+mod displacement_prior;
 mod free_start;
-pub use free_start::{CtRegistration, StartPrior, register_ct_ndt_free_start};
+mod rate_prior;
+pub use displacement_prior::DisplacementPrior;
+pub use free_start::{
+    CtPriors, CtRegistration, StartPrior, register_ct_ndt_free_start, register_ct_ndt_with_priors,
+};
+pub use rate_prior::RatePrior;
 
 /// Start and end times of a scan on the sensor clock (s).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -31,8 +31,9 @@ mod voxel_box;
 mod test_support;
 
 pub use ct_ndt::{
-    CtRegistration, ScanTimes, StartPrior, ct_point_jacobian, interpolate, register_ct_ndt,
-    register_ct_ndt_free_start,
+    CtPriors, CtRegistration, DisplacementPrior, RatePrior, ScanTimes, StartPrior,
+    ct_point_jacobian, interpolate, register_ct_ndt, register_ct_ndt_free_start,
+    register_ct_ndt_with_priors,
 };
 pub use error::RegistrationError;
 pub use icp::{IcpFarLookupStats, IcpLookupStats, IcpModel, register_icp};

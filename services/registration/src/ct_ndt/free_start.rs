@@ -17,6 +17,8 @@
 //! The reported information is that of `T^e` with `T^s` marginalised out
 //! (Schur complement), the reported cost that of the points alone.
 
+use super::displacement_prior::DisplacementPrior;
+use super::rate_prior::RatePrior;
 use super::{Interpolation, ScanTimes, constrained_directions, exp_coefficients};
 use crate::error::RegistrationError;
 use crate::ndt_map::NdtMap;
@@ -243,6 +245,43 @@ impl Joint {
         gv += g_s;
     }
 
+    /// Adds the prior `eᵀ Ω e` of a [`RatePrior`] on the turn over the
+    /// scan; it touches only the rotation blocks of both ends.
+    fn add_rate_prior(&mut self, start: &Pose, end: &Pose, rate: &RatePrior) {
+        let r = rate.residual(&start.rotation, &end.rotation);
+        let w = &rate.information;
+        let blocks = [(0, r.j_start), (6, r.j_end)];
+        for &(i, ji) in &blocks {
+            let mut gv = self.g.fixed_rows_mut::<3>(i);
+            gv += ji.tr_mul(&(w * r.e));
+            for &(j, jj) in &blocks {
+                let mut hv = self.h.fixed_view_mut::<3, 3>(i, j);
+                hv += ji.tr_mul(&(w * jj));
+            }
+        }
+    }
+
+    /// Adds the prior `eᵀ Ω e` of a [`DisplacementPrior`]; it touches the
+    /// rotation and translation blocks of both ends.
+    fn add_displacement_prior(&mut self, start: &Pose, end: &Pose, prior: &DisplacementPrior) {
+        let r = prior.residual(start, end);
+        let w = &prior.information;
+        let blocks = [
+            (0, r.j_start.0),
+            (3, r.j_start.1),
+            (6, r.j_end.0),
+            (9, r.j_end.1),
+        ];
+        for &(i, ji) in &blocks {
+            let mut gv = self.g.fixed_rows_mut::<3>(i);
+            gv += ji.tr_mul(&(w * r.e));
+            for &(j, jj) in &blocks {
+                let mut hv = self.h.fixed_view_mut::<3, 3>(i, j);
+                hv += ji.tr_mul(&(w * jj));
+            }
+        }
+    }
+
     /// The information of `T^e` with `T^s` marginalised out.
     fn end_information(&self) -> Matrix6<f64> {
         let h_ss = self.h.fixed_view::<6, 6>(0, 0).into_owned();
@@ -339,9 +378,66 @@ pub fn register_ct_ndt_free_start(
     initial_t_target_sensor_end: &Pose,
     params: &NdtParams,
 ) -> Result<CtRegistration, RegistrationError> {
+    let priors = CtPriors {
+        start: *prior,
+        rate: None,
+        displacement: None,
+    };
+    register_ct_ndt_with_priors(
+        map,
+        source,
+        scan,
+        &priors,
+        initial_t_target_sensor_end,
+        params,
+    )
+}
+
+/// The priors of [`register_ct_ndt_with_priors`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CtPriors {
+    /// The prior on the start pose `T^s`.
+    pub start: StartPrior,
+    /// An optional prior on the turn over the scan (see [`RatePrior`]).
+    pub rate: Option<RatePrior>,
+    /// An optional prior on the displacement of the target origin over the
+    /// scan (see [`DisplacementPrior`]).
+    pub displacement: Option<DisplacementPrior>,
+}
+
+/// [`register_ct_ndt_free_start`] with, optionally, a [`RatePrior`] on the
+/// turn and a [`DisplacementPrior`] on the displacement over the scan as
+/// well (with both, the start prior may be zero: the points then fix the
+/// pose, the priors its motion over the scan). The reported information of `T^e` includes
+/// both priors (start marginalised out). Same errors, plus an invalid
+/// rate prior.
+pub fn register_ct_ndt_with_priors(
+    map: &NdtMap,
+    source: &[Point],
+    scan: &ScanTimes,
+    priors: &CtPriors,
+    initial_t_target_sensor_end: &Pose,
+    params: &NdtParams,
+) -> Result<CtRegistration, RegistrationError> {
     params.validate()?;
     scan.validate()?;
+    let prior = &priors.start;
     prior.validate()?;
+    if let Some(rate) = &priors.rate {
+        rate.validate()?;
+    }
+    if let Some(d) = &priors.displacement {
+        d.validate()?;
+    }
+    let add_priors = |joint: &mut Joint, start: &Pose, end: &Pose| {
+        joint.add_prior(start, prior);
+        if let Some(rate) = &priors.rate {
+            joint.add_rate_prior(start, end, rate);
+        }
+        if let Some(d) = &priors.displacement {
+            joint.add_displacement_prior(start, end, d);
+        }
+    };
     check_pose("initial_t_target_sensor_end", initial_t_target_sensor_end)?;
     if source.is_empty() {
         return Err(RegistrationError::EmptyCloud);
@@ -383,7 +479,7 @@ pub fn register_ct_ndt_free_start(
             return Err(no_match(it));
         }
         let data_only = (joint.cost, joint.squared_distance);
-        joint.add_prior(&start, prior);
+        add_priors(&mut joint, &start, &end);
         let eps = joint
             .solve(basis.as_ref())
             .ok_or_else(|| degenerate(it, joint.inliers))?;
@@ -410,7 +506,7 @@ pub fn register_ct_ndt_free_start(
         None => {
             let mut j = linearise(map, &points, &start, &end, params);
             let data_only = (j.cost, j.squared_distance);
-            j.add_prior(&start, prior);
+            add_priors(&mut j, &start, &end);
             (j.cost, j.squared_distance) = data_only;
             j
         }

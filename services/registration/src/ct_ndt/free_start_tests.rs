@@ -173,6 +173,147 @@ fn bad_prior_is_an_error_value() {
     ));
 }
 
+/// The turn `R^e (R^s)ᵀ` of a CT-NDT result.
+fn turn_of(r: &CtRegistration) -> nalgebra::Rotation3<f64> {
+    r.end.t_target_sensor.rotation * r.t_target_sensor_start.rotation.inverse()
+}
+
+/// A firm prior on the turn over the scan imposes it: at the true turn the
+/// result is as good as without it, at a turn 1° off the result turns by
+/// that instead, while the loose start prior lets the pose follow the
+/// points. Without the rate prior the scan finds the true turn.
+#[test]
+fn a_firm_rate_prior_imposes_the_turn() {
+    let (frame, start, end, scan) = blurred_scan();
+    let params = NdtParams::default();
+    let guess = perturb(&end, 2f64.to_radians(), 0.02, &mut rng(14));
+    let s_rot = 3f64.to_radians();
+    let information = Matrix6::from_diagonal(&Vector6::new(
+        1.0 / (s_rot * s_rot),
+        1.0 / (s_rot * s_rot),
+        1.0 / (s_rot * s_rot),
+        100.0,
+        100.0,
+        100.0,
+    ));
+    let start_prior = StartPrior {
+        t_target_sensor: start,
+        information,
+    };
+    let true_turn = end.rotation * start.rotation.inverse();
+    let off = so3::exp(&Vector3::new(0.0, 1f64.to_radians(), 0.0));
+    let run = |turn: Option<nalgebra::Rotation3<f64>>| {
+        let priors = CtPriors {
+            start: start_prior,
+            rate: turn.map(|turn| RatePrior {
+                turn,
+                information: Matrix3::identity() * 1e12,
+            }),
+            displacement: None,
+        };
+        register_ct_ndt_with_priors(map(), &frame, &scan, &priors, &guess, &params).unwrap()
+    };
+    let deg = |a: &nalgebra::Rotation3<f64>, b: &nalgebra::Rotation3<f64>| {
+        so3::distance(a, b).to_degrees()
+    };
+    let free = run(None);
+    let at_truth = run(Some(true_turn));
+    let wrong = run(Some(off * true_turn));
+    println!(
+        "turn error: free {:.3}°, at truth {:.2e}°, 1° off {:.2e}° from its prior",
+        deg(&turn_of(&free), &true_turn),
+        deg(&turn_of(&at_truth), &true_turn),
+        deg(&turn_of(&wrong), &(off * true_turn))
+    );
+    assert!(deg(&turn_of(&free), &true_turn) < 0.6);
+    assert!(deg(&turn_of(&at_truth), &true_turn) < 1e-3);
+    assert!(deg(&turn_of(&wrong), &(off * true_turn)) < 1e-3);
+    // The true turn helps the end pose (free: 0.23°, 18 mm).
+    let (ang, d) = at_truth.end.t_target_sensor.error_to(&end);
+    let (free_ang, free_d) = free.end.t_target_sensor.error_to(&end);
+    assert!(ang < free_ang && d < free_d, "{ang} rad, {d} m");
+    assert!(ang.to_degrees() < 0.1 && d < 0.015, "{ang} rad, {d} m");
+    let (ang, _) = wrong.end.t_target_sensor.error_to(&end);
+    assert!(ang.to_degrees() > 0.2, "{} deg", ang.to_degrees());
+    // The firm turn adds information: the end pose's marginal grows.
+    let trace = |r: &CtRegistration| r.end.information.fixed_view::<3, 3>(0, 0).trace();
+    assert!(trace(&at_truth) > trace(&free));
+}
+
+/// The target origin in the sensor frame, `-Rᵀ t` of `t_target_sensor`.
+fn origin(p: &Pose) -> Vector3<f64> {
+    -(p.rotation.inverse() * p.translation)
+}
+
+/// With firm priors on the turn and the displacement at their true values,
+/// no start prior is needed: the points fix the pose, which lands on the
+/// truth (the motion-compensated fit of `deblur`, in the limit).
+#[test]
+fn firm_motion_priors_need_no_start_prior() {
+    let (frame, start, end, scan) = blurred_scan();
+    let guess = perturb(&end, 2f64.to_radians(), 0.02, &mut rng(14));
+    let priors = CtPriors {
+        start: StartPrior {
+            t_target_sensor: perturb(&start, 0.1, 0.5, &mut rng(16)),
+            information: Matrix6::zeros(),
+        },
+        rate: Some(RatePrior {
+            turn: end.rotation * start.rotation.inverse(),
+            information: Matrix3::identity() * 1e12,
+        }),
+        displacement: Some(DisplacementPrior {
+            displacement_m: origin(&end) - origin(&start),
+            information: Matrix3::identity() * 1e12,
+        }),
+    };
+    let r =
+        register_ct_ndt_with_priors(map(), &frame, &scan, &priors, &guess, &NdtParams::default())
+            .unwrap();
+    let (ang, d) = r.end.t_target_sensor.error_to(&end);
+    let (s_ang, s_d) = r.t_target_sensor_start.error_to(&start);
+    println!(
+        "end {:.4}° {:.2} mm, start {:.4}° {:.2} mm",
+        ang.to_degrees(),
+        d * 1e3,
+        s_ang.to_degrees(),
+        s_d * 1e3
+    );
+    // NDT's own error on this noisy frame (0.07°, 4.5 mm); the loose start
+    // prior alone leaves 0.23° and 18 mm (test above).
+    assert!(ang.to_degrees() < 0.1 && d < 0.006, "{ang} rad, {d} m");
+    assert!(s_ang.to_degrees() < 0.1 && s_d < 0.006);
+    // A displacement prior 3 cm off moves both poses by that instead.
+    let mut off = priors;
+    if let Some(p) = off.displacement.as_mut() {
+        p.displacement_m.x += 0.03;
+    }
+    let r = register_ct_ndt_with_priors(map(), &frame, &scan, &off, &guess, &NdtParams::default())
+        .unwrap();
+    let moved = origin(&r.end.t_target_sensor) - origin(&r.t_target_sensor_start);
+    assert!((moved - off.displacement.unwrap().displacement_m).norm() < 1e-4);
+}
+
+#[test]
+fn bad_rate_prior_is_an_error_value() {
+    let (frame, start, _, scan) = blurred_scan();
+    let priors = CtPriors {
+        start: StartPrior {
+            t_target_sensor: start,
+            information: Matrix6::identity(),
+        },
+        rate: Some(RatePrior {
+            turn: nalgebra::Rotation3::identity(),
+            information: Matrix3::identity() * f64::NAN,
+        }),
+        displacement: None,
+    };
+    let p = NdtParams::default();
+    assert!(matches!(
+        register_ct_ndt_with_priors(map(), &frame, &scan, &priors, &start, &p),
+        Err(RegistrationError::InvalidParameter { .. })
+    ));
+}
+
 /// `linearise`'s structured sums equal `Σ JᵀPJ` and `Σ JᵀPr` formed from
 /// the dense 3×12 Jacobian `[∂p/∂δ^s, ∂p/∂δ^e]` of every inlier.
 #[test]
