@@ -129,6 +129,8 @@ pub struct TrackerConfig {
     /// 10, 30, 100, 300 (ct-ndt max after warm-up 57.1, 10.0, 7.3°, lost,
     /// lost; the position was scaled with it then, which `deblur` did not
     /// survive on seeds 1 or 11, hence attitude only and ct-ndt only).
+    /// Default 1 since the motion prior (`ct_ndt_motion_prior_weight`),
+    /// which keeps the end pose from wandering; with the prior off, use 30.
     pub ct_ndt_attitude_covariance_scale: f64,
     /// In `ct-ndt` mode, a frame with fewer points than this after the
     /// voxel filter is registered as one pose on the cloud motion-compensated
@@ -141,7 +143,19 @@ pub struct TrackerConfig {
     /// 5000: slow-spin max 3.22, 2.03, 2.01, 2.95° (mean over its frames
     /// below 3000 points 0.85, 0.58, 0.55, 0.61°); tumbling max 2.27, 2.01,
     /// 1.81, 1.89° (0.94, 0.68, 0.68, 0.67°). 4000, the lowest max on both.
+    /// Default 0 since the motion prior (`ct_ndt_motion_prior_weight`),
+    /// which steadies sparse frames itself; with the prior off, use 4000.
     pub ct_ndt_min_points: usize,
+    /// In `ct-ndt` mode (with `ct_start = "filter-prior"`), weight of a
+    /// prior on the motion over the scan instead of the prior on the start
+    /// pose: the filter's predicted turn and displacement, with the
+    /// information of its angular and linear velocities over the scan
+    /// (`(Δt² Σ_ω)⁻¹`, `(Δt² Σ_v)⁻¹`, in the start prior's units) times
+    /// this. 0 = none (the start prior of the free-start CT-NDT); large = the
+    /// predicted motion, i.e. `deblur`. Not in the paper; see
+    /// `spacepose_registration::{RatePrior, DisplacementPrior}` and the
+    /// README, "ct-ndt's motion prior".
+    pub ct_ndt_motion_prior_weight: f64,
     /// Relative-motion filter tuning.
     pub filter: FilterConfig,
     /// Degraded / lost thresholds.
@@ -168,7 +182,14 @@ pub enum CtStart {
 pub const DEFAULT_RELEASE_LEVER_ARM_M: f64 = 0.045;
 
 /// Default [`TrackerConfig::ct_ndt_min_points`].
-pub const DEFAULT_CT_NDT_MIN_POINTS: usize = 4000;
+pub const DEFAULT_CT_NDT_MIN_POINTS: usize = 0;
+
+/// Default [`TrackerConfig::ct_ndt_motion_prior_weight`].
+pub const DEFAULT_CT_NDT_MOTION_PRIOR_WEIGHT: f64 = 1.0;
+
+/// Default [`TrackerConfig::ct_ndt_attitude_covariance_scale`]: 1 with the
+/// motion prior; 30 was tuned for the free-start CT-NDT without it.
+pub const DEFAULT_CT_NDT_ATTITUDE_COVARIANCE_SCALE: f64 = 1.0;
 
 /// Default [`TrackerConfig::ndt_mode_min_lever_arm_m`] (m).
 pub const DEFAULT_NDT_MODE_MIN_LEVER_ARM_M: f64 = 0.05;
@@ -192,8 +213,9 @@ impl Default for TrackerConfig {
             icp: IcpParams::default(),
             geometric_sigma_m: 0.0,
             ct_start: CtStart::default(),
-            ct_ndt_attitude_covariance_scale: 30.0,
+            ct_ndt_attitude_covariance_scale: DEFAULT_CT_NDT_ATTITUDE_COVARIANCE_SCALE,
             ct_ndt_min_points: DEFAULT_CT_NDT_MIN_POINTS,
+            ct_ndt_motion_prior_weight: DEFAULT_CT_NDT_MOTION_PRIOR_WEIGHT,
             // The tracker checks consistency with absolute innovation limits
             // (`LossConfig`): the registration's information is far more
             // confident than the model errors justify, so a χ² gate on it
@@ -238,6 +260,10 @@ impl TrackerConfig {
                 "ct_ndt_attitude_covariance_scale must be finite and > 0",
                 s,
             ));
+        }
+        let w = self.ct_ndt_motion_prior_weight;
+        if !(w.is_finite() && w >= 0.0) {
+            return Err(bad("ct_ndt_motion_prior_weight must be finite and >= 0", w));
         }
         let n = self.ndt_mode_min_lever_arm_m;
         if !(n.is_finite() && n >= 0.0) {

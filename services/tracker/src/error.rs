@@ -37,7 +37,8 @@ pub enum TrackError {
     #[error("filter failed: {0}")]
     Filter(#[from] FilterError),
     /// The filter's covariance at a scan start is not positive definite, so
-    /// it gives `ct-ndt` no prior on the start pose.
+    /// it gives `ct-ndt` no prior on the start pose (or, with
+    /// `TrackerConfig::ct_ndt_motion_prior_weight`, on the motion over the scan).
     #[error("no start-pose prior: the filter covariance at t = {t_s} s is not positive definite")]
     NoStartPrior {
         /// Scan start (s).

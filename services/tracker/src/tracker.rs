@@ -8,12 +8,12 @@ use crate::mode::TrackingMode;
 use crate::model::TrackingModel;
 use crate::output::{Timings, TrackOutput};
 use crate::status::TrackStatus;
-use nalgebra::{Matrix6, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 use spacepose_filter::{MotionCompensation, Prediction, RelativeMotionFilter};
 use spacepose_geometry::{Point, Pose, VoxelFilter, so3};
 use spacepose_registration::{
-    NdtParams, Registration, ScanTimes, StartPrior, register_ct_ndt, register_ct_ndt_free_start,
-    register_icp, register_ndt,
+    CtPriors, DisplacementPrior, NdtParams, RatePrior, Registration, ScanTimes, StartPrior,
+    register_ct_ndt, register_ct_ndt_with_priors, register_icp, register_ndt,
 };
 use std::time::Instant;
 
@@ -332,8 +332,8 @@ impl Tracker {
                     register_ct_ndt(map, cloud, scan, &start, &predicted, ndt)?
                 }
                 CtStart::FilterPrior => {
-                    let prior = self.ct_start_prior(scan.start_s)?;
-                    register_ct_ndt_free_start(map, cloud, scan, &prior, &predicted, ndt)?.end
+                    let priors = self.ct_priors(prediction, scan)?;
+                    register_ct_ndt_with_priors(map, cloud, scan, &priors, &predicted, ndt)?.end
                 }
             },
         })
@@ -373,6 +373,61 @@ impl Tracker {
         Ok(StartPrior {
             t_target_sensor: at_start.pose.inverse(),
             information,
+        })
+    }
+
+    /// The priors of the free-start CT-NDT. Without a motion prior
+    /// (`TrackerConfig::ct_ndt_motion_prior_weight` = 0), the filter's
+    /// estimate at the scan start. With one, the filter's predicted motion
+    /// over the scan (turn and displacement) and no prior on the start pose:
+    /// the filter's start pose and motion together would be a prior on the
+    /// end pose, which tells the filter back what it predicted (tried: the
+    /// tumble was lost). The pose is then the points', its motion over the
+    /// scan the filter's within the filter's confidence.
+    fn ct_priors(&self, at_end: &Prediction, scan: &ScanTimes) -> Result<CtPriors, TrackError> {
+        let weight = self.config.ct_ndt_motion_prior_weight;
+        if weight == 0.0 {
+            return Ok(CtPriors {
+                start: self.ct_start_prior(scan.start_s)?,
+                rate: None,
+                displacement: None,
+            });
+        }
+        let at_start = self.filter.predict_at(scan.start_s)?;
+        let dt = scan.end_s - scan.start_s;
+        let scale = self.filter.config().registration_covariance_scale * weight;
+        // Δt² times the velocity covariances, in the start prior's units.
+        let information = |cov: Matrix3<f64>, s: f64| {
+            let cov = cov * (dt * dt);
+            ((cov + cov.transpose()) * 0.5)
+                .cholesky()
+                .map(|c| c.inverse() * s)
+                .ok_or(TrackError::NoStartPrior { t_s: scan.start_s })
+        };
+        let cov_w = at_start
+            .attitude_covariance
+            .fixed_view::<3, 3>(3, 3)
+            .into_owned();
+        let cov_v = at_start
+            .position_covariance
+            .fixed_view::<3, 3>(3, 3)
+            .into_owned();
+        let rate = RatePrior {
+            // R^e (R^s)ᵀ of t_target_sensor: Exp(-ω Δt) in the target frame.
+            turn: at_end.pose.rotation.inverse() * at_start.pose.rotation,
+            information: information(cov_w, scale * self.ct_attitude_scale())?,
+        };
+        let displacement = DisplacementPrior {
+            displacement_m: at_end.pose.translation - at_start.pose.translation,
+            information: information(cov_v, scale)?,
+        };
+        Ok(CtPriors {
+            start: StartPrior {
+                t_target_sensor: at_start.pose.inverse(),
+                information: Matrix6::zeros(),
+            },
+            rate: Some(rate),
+            displacement: Some(displacement),
         })
     }
 
