@@ -28,7 +28,7 @@ use anyhow::{Context, Result, bail};
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde::Serialize;
-use spacepose_lidar_sim::{Frame, LidarSimulator, SensorConfig};
+use spacepose_lidar_sim::{Frame, LidarSimulator, ReturnKind, SensorConfig};
 use spacepose_registration::NdtMapParams;
 use spacepose_scenario::{Scenario, ScenarioConfig, build};
 use spacepose_tracker::{TrackStatus, Tracker, TrackerConfig, TrackingMode, TrackingModel};
@@ -113,6 +113,13 @@ pub struct FrameRecord {
     pub points_used: usize,
     /// Why the frame is degraded or lost (empty when tracking).
     pub reason: String,
+    /// Scan blur: the angle the true attitude turns between the mean time
+    /// of the frame's target returns and the scan end (deg). A one-pose fit
+    /// of the uncompensated cloud sees the target near its mean time, so
+    /// `ndt` and `icp` modes lag the end-of-scan truth by about this much
+    /// even when fully converged (see [`blur_lag_deg`]). The same in every
+    /// mode.
+    pub blur_lag_deg: f64,
 }
 
 /// Summary of one mode (the columns of seed 000 Tables 2-3).
@@ -163,6 +170,8 @@ pub struct TrackingReport {
     pub warmup: usize,
     /// Mean raw points per frame.
     pub mean_points_in: f64,
+    /// Scan blur over the frames (deg; see [`FrameRecord::blur_lag_deg`]).
+    pub blur_lag_deg: MeanMax,
     /// Results per mode name.
     pub modes: BTreeMap<String, ModeReport>,
 }
@@ -208,13 +217,18 @@ pub fn evaluate(config: &EvalConfig) -> Result<TrackingReport> {
     let mut records: Vec<Vec<FrameRecord>> = vec![Vec::with_capacity(frames); trackers.len()];
     let bar = progress_bar(frames as u64, "tracking");
     let mut points_total = 0usize;
+    let mut lags = Vec::with_capacity(frames);
     for (batch_index, batch) in end_times.chunks(8).enumerate() {
         let first = config.first_frame + batch_index * 8;
         let simulated = simulate_batch(&simulator, scenario.as_ref(), batch, first, config.seed)?;
         for (offset, frame) in simulated.iter().enumerate() {
             points_total += frame.points.len();
+            let lag = blur_lag_deg(scenario.as_ref(), frame);
+            lags.push(lag);
             for (tracker, out) in trackers.iter_mut().zip(records.iter_mut()) {
-                out.push(track_frame(tracker, frame, first + offset)?);
+                let mut record = track_frame(tracker, frame, first + offset)?;
+                record.blur_lag_deg = lag;
+                out.push(record);
             }
             bar.inc(1);
         }
@@ -235,6 +249,7 @@ pub fn evaluate(config: &EvalConfig) -> Result<TrackingReport> {
         compression: config.compression,
         warmup: config.warmup,
         mean_points_in: points_total as f64 / frames as f64,
+        blur_lag_deg: MeanMax::of(&lags),
         modes,
     })
 }
@@ -291,6 +306,27 @@ fn simulate_batch(
         .collect()
 }
 
+/// The angle (deg) between the true attitude at the mean time of the
+/// frame's target returns and at its end: the lag of a one-pose fit of the
+/// blurred cloud. NaN for a frame without target returns.
+pub fn blur_lag_deg(scenario: &dyn Scenario, frame: &Frame) -> f64 {
+    let times: Vec<f64> = frame
+        .points
+        .iter()
+        .zip(&frame.kinds)
+        .filter(|(_, k)| **k == ReturnKind::Target)
+        .map(|(p, _)| p.t)
+        .collect();
+    if times.is_empty() {
+        return f64::NAN;
+    }
+    let t_mean = times.iter().sum::<f64>() / times.len() as f64;
+    let (ang, _) = scenario
+        .pose_at(t_mean)
+        .error_to(&frame.truth.t_sensor_target);
+    ang.to_degrees()
+}
+
 fn track_frame(tracker: &mut Tracker, frame: &Frame, index: usize) -> Result<FrameRecord> {
     let out = tracker
         .process(&frame.points, frame.scan_start, frame.scan_end)
@@ -326,6 +362,7 @@ fn track_frame(tracker: &mut Tracker, frame: &Frame, index: usize) -> Result<Fra
             .registration
             .as_ref()
             .map_or(0, |r| r.degenerate_directions),
+        blur_lag_deg: f64::NAN,
         weakest_lever_arm_m: out
             .registration
             .as_ref()
@@ -434,7 +471,8 @@ pub fn render(report: &TrackingReport) -> String {
     format!(
         "{} with {}: {} frames from frame {} (seed {}, compression {}), {:.0} raw points per frame on average\n\
          errors in deg and cm; time in ms per frame, one thread, voxel filter included;\n\
-         ang max* = max after {} warm-up frames; diverged = true error > {DIVERGED_DEG}° or {} cm\n{}",
+         ang max* = max after {} warm-up frames; diverged = true error > {DIVERGED_DEG}° or {} cm\n\
+         scan blur: the truth turns {:.2}° on average ({:.2}° max) between a frame's mean return time and its end\n{}",
         report.scenario,
         report.target,
         report.frames,
@@ -444,6 +482,8 @@ pub fn render(report: &TrackingReport) -> String {
         report.mean_points_in,
         report.warmup,
         DIVERGED_M * 100.0,
+        report.blur_lag_deg.mean,
+        report.blur_lag_deg.max,
         t.render()
     )
 }
@@ -528,4 +568,44 @@ fn load_tracker_config(path: &std::path::Path) -> Result<TrackerConfig> {
         .validate()
         .with_context(|| format!("validating {}", path.display()))?;
     Ok(config)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use spacepose_geometry::Point;
+    use spacepose_scenario::ScenarioKind;
+
+    fn point_at(t: f64) -> Point {
+        Point {
+            x: 0.0,
+            y: 0.0,
+            z: 10.0,
+            intensity: 1.0,
+            t,
+        }
+    }
+
+    #[test]
+    fn blur_lag_is_the_turn_since_the_mean_target_return() {
+        let scenario = build(&ScenarioConfig::default_for(ScenarioKind::Tumbling)).unwrap();
+        let end = scenario.frame_end_times(5)[4];
+        let mut frame = Frame {
+            points: vec![point_at(end - 1.0), point_at(end), point_at(end - 1.0)],
+            kinds: vec![ReturnKind::Target, ReturnKind::Target, ReturnKind::Clutter],
+            scan_start: end - 1.0,
+            scan_end: end,
+            truth: scenario.state_at(end),
+        };
+        // The clutter return does not count: the mean time is end − 0.5 s.
+        let lag = blur_lag_deg(scenario.as_ref(), &frame);
+        let (expected, _) = scenario
+            .pose_at(end - 0.5)
+            .error_to(&frame.truth.t_sensor_target);
+        assert!((lag - expected.to_degrees()).abs() < 1e-9, "{lag}");
+        // Half a second of a 10°/s tumble (plus its precession).
+        assert!((4.0..7.0).contains(&lag), "{lag}");
+        frame.kinds = vec![ReturnKind::Outlier; 3];
+        assert!(blur_lag_deg(scenario.as_ref(), &frame).is_nan());
+    }
 }
