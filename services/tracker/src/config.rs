@@ -156,6 +156,17 @@ pub struct TrackerConfig {
     /// `spacepose_registration::{RatePrior, DisplacementPrior}` and the
     /// README, "ct-ndt's motion prior".
     pub ct_ndt_motion_prior_weight: f64,
+    /// In `ct-ndt` mode, a frame whose CT-NDT stalls (stops at its
+    /// iteration limit still moving by more than
+    /// `loss.max_final_increment_*`) is fitted again as `deblur` fits it:
+    /// one pose on the cloud motion-compensated by the prediction; that
+    /// result is assessed and fused instead, and flagged
+    /// ([`crate::TrackOutput::fallback`]). Not in the paper. Without it such
+    /// a frame is reported `degraded` with CT-NDT's pose: tumbling seed 13,
+    /// frame 84 (2,148 points), 4.50°; with it 2.69° (the one-pose fit
+    /// stalled too, so the frame stays `degraded` and is not fused).
+    /// Default true.
+    pub ct_ndt_stall_fallback: bool,
     /// Relative-motion filter tuning.
     pub filter: FilterConfig,
     /// Degraded / lost thresholds.
@@ -216,6 +227,7 @@ impl Default for TrackerConfig {
             ct_ndt_attitude_covariance_scale: DEFAULT_CT_NDT_ATTITUDE_COVARIANCE_SCALE,
             ct_ndt_min_points: DEFAULT_CT_NDT_MIN_POINTS,
             ct_ndt_motion_prior_weight: DEFAULT_CT_NDT_MOTION_PRIOR_WEIGHT,
+            ct_ndt_stall_fallback: true,
             // The tracker checks consistency with absolute innovation limits
             // (`LossConfig`): the registration's information is far more
             // confident than the model errors justify, so a χ² gate on it

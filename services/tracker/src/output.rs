@@ -49,6 +49,11 @@ pub struct TrackOutput {
     pub points_used: usize,
     /// Time spent.
     pub timings: Timings,
+    /// `ct-ndt` mode: CT-NDT stalled (no convergence, still moving at its
+    /// iteration limit), and this pose is the one-pose fit of the cloud
+    /// motion-compensated by the prediction, as `deblur` computes it
+    /// ([`crate::TrackerConfig::ct_ndt_stall_fallback`]).
+    pub fallback: bool,
 }
 
 impl TrackOutput {

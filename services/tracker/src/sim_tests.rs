@@ -2,7 +2,7 @@
 //! sensor effect on, 1 s integration at 1 Hz) with known ground truth.
 //! Seeds used here are test seeds, not the evaluation's.
 
-use crate::{TrackStatus, Tracker, TrackerConfig, TrackingMode, TrackingModel};
+use crate::{TrackOutput, TrackStatus, Tracker, TrackerConfig, TrackingMode, TrackingModel};
 use nalgebra::Vector3;
 use spacepose_geometry::Pose;
 use spacepose_lidar_sim::{LidarSimulator, SensorConfig};
@@ -47,6 +47,27 @@ fn run_configs(
     frames: usize,
     seed: u64,
 ) -> Vec<Vec<(TrackStatus, f64, f64, Pose)>> {
+    run_outputs(kind, configs, first, frames, seed)
+        .into_iter()
+        .map(|res| {
+            res.into_iter()
+                .map(|(out, truth)| {
+                    let (ang, pos) = out.t_sensor_target.error_to(&truth);
+                    (out.status, ang.to_degrees(), pos, out.t_sensor_target)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The tracker outputs of [`run_configs`], with the true `t_sensor_target`.
+fn run_outputs(
+    kind: ScenarioKind,
+    configs: &[TrackerConfig],
+    first: usize,
+    frames: usize,
+    seed: u64,
+) -> Vec<Vec<(TrackOutput, Pose)>> {
     let (target, model) = deos();
     let mut config = ScenarioConfig::default_for(kind);
     config.seed = seed;
@@ -80,8 +101,7 @@ fn run_configs(
             let out = tracker
                 .process(&frame.points, frame.scan_start, frame.scan_end)
                 .unwrap();
-            let (ang, pos) = out.t_sensor_target.error_to(&frame.truth.t_sensor_target);
-            res.push((out.status, ang.to_degrees(), pos, out.t_sensor_target));
+            res.push((out, frame.truth.t_sensor_target));
         }
     }
     results
@@ -189,4 +209,39 @@ fn a_firm_motion_prior_makes_ct_ndt_follow_deblur() {
             gap(&f.3, &d.3)
         );
     }
+}
+
+#[test]
+fn a_stalled_ct_ndt_frame_is_fitted_as_deblur_fits_it() {
+    // Three iterations and no tolerance on the last step: from zero initial
+    // rates, CT-NDT cannot converge on the tumble's first frame.
+    let stalling = |mode, fallback| {
+        let mut c = TrackerConfig::with_mode(mode);
+        c.ndt.max_iterations = 3;
+        c.loss.max_final_increment_deg = 1e-9;
+        c.loss.max_final_increment_m = 1e-9;
+        c.ct_ndt_stall_fallback = fallback;
+        c
+    };
+    let configs = [
+        stalling(TrackingMode::CtNdt, true),
+        stalling(TrackingMode::CtNdt, false),
+        stalling(TrackingMode::Deblur, true),
+    ];
+    let res = run_outputs(ScenarioKind::Tumbling, &configs, 0, 1, 12);
+    let (with, without, deblur) = (&res[0][0].0, &res[1][0].0, &res[2][0].0);
+    assert!(!without.fallback);
+    let stalled = without.registration.as_ref().unwrap();
+    assert!(!stalled.converged && stalled.iterations == 3);
+    assert_eq!(without.status, TrackStatus::Degraded, "{}", without.reason);
+    assert!(
+        without.reason.contains("no convergence"),
+        "{}",
+        without.reason
+    );
+    assert!(with.fallback, "{}", with.reason);
+    assert!(!deblur.fallback);
+    // The fallback is deblur's computation on the same frame and guess.
+    assert_eq!(with.t_sensor_target, deblur.t_sensor_target);
+    assert_eq!(with.points_used, deblur.points_used);
 }

@@ -210,11 +210,23 @@ impl Tracker {
                 return Ok(self.declare_lost(&prediction, points.len(), e.to_string(), started));
             }
         };
+        let (registration, compensated, points_used, fallback) = match self.stall_fallback(
+            points,
+            &registration,
+            compensated,
+            &prediction,
+            &last,
+            &scan,
+        ) {
+            Some((r, n)) => (r, true, n, true),
+            None => (registration, compensated, cloud.len(), false),
+        };
         let registration_ms = ms(reg_start);
         self.holding = registration.degenerate_directions > 0;
         let registration = self.follow_held_rate(scan_end, registration);
-        let counts = (points.len(), cloud.len());
+        let counts = (points.len(), points_used);
         let mut out = self.assess(registration, compensated, &prediction, scan_end, counts)?;
+        out.fallback = fallback;
         if let (TrackStatus::Tracking, Some(r)) = (out.status, out.registration.as_ref()) {
             self.held.record(
                 scan_end,
@@ -255,6 +267,44 @@ impl Tracker {
         registration
     }
 
+    /// [`TrackerConfig::ct_ndt_stall_fallback`]: when CT-NDT stalled, the
+    /// one-pose fit of the cloud compensated by the prediction (`deblur`'s
+    /// registration) and its point count; `None` otherwise, or when that
+    /// fit fails too (the stalled result then stands, and is doubted).
+    fn stall_fallback(
+        &mut self,
+        points: &[Point],
+        registration: &Registration,
+        compensated: bool,
+        prediction: &Prediction,
+        last: &LastPose,
+        scan: &ScanTimes,
+    ) -> Option<(Registration, usize)> {
+        let c = &self.config;
+        if c.mode != TrackingMode::CtNdt
+            || compensated
+            || !c.ct_ndt_stall_fallback
+            || !self.stalled(registration)
+        {
+            return None;
+        }
+        let cloud = self.compensated_cloud(points, prediction).ok()?;
+        match self.register(&cloud, true, prediction, last, scan) {
+            Ok(r) => {
+                tracing::debug!(
+                    t = scan.end_s,
+                    iterations = registration.iterations,
+                    "CT-NDT stalled: the frame is fitted as one pose on the compensated cloud"
+                );
+                Some((r, cloud.len()))
+            }
+            Err(e) => {
+                tracing::debug!(t = scan.end_s, error = %e, "CT-NDT stalled, and so did its fallback");
+                None
+            }
+        }
+    }
+
     /// Motion compensation (Eq. 12) and the voxel filter. Returns the cloud
     /// and whether it was compensated: always in `deblur` mode, and in
     /// `ct-ndt` mode when the frame has fewer than
@@ -280,11 +330,21 @@ impl Tracker {
                 return Ok((self.voxel.filter(points)?.points, false));
             }
         }
+        Ok((self.compensated_cloud(points, prediction)?, true))
+    }
+
+    /// The raw points motion-compensated to the scan end by the prediction
+    /// (Eq. 12), then voxel-filtered.
+    fn compensated_cloud(
+        &mut self,
+        points: &[Point],
+        prediction: &Prediction,
+    ) -> Result<Vec<Point>, TrackError> {
         // One copy of the finite points, compensated in place (Eq. 12, one
         // sin_cos per point about the fixed axis R ω).
         let mut finite: Vec<Point> = points.iter().copied().filter(Point::is_finite).collect();
         MotionCompensation::from_prediction(prediction)?.compensate_in_place(&mut finite)?;
-        Ok((self.voxel.filter(&finite)?.points, true))
+        Ok(self.voxel.filter(&finite)?.points)
     }
 
     /// Runs the registration of the current mode from its initial guess;
@@ -525,7 +585,17 @@ impl Tracker {
             points_in,
             points_used,
             timings: Timings::default(),
+            fallback: false,
         })
+    }
+
+    /// A registration that stopped at its iteration limit while still
+    /// moving by more than `loss.max_final_increment_*`.
+    fn stalled(&self, r: &Registration) -> bool {
+        let l = &self.config.loss;
+        !r.converged
+            && (r.last_increment.rotation_rad.to_degrees() > l.max_final_increment_deg
+                || r.last_increment.translation_m > l.max_final_increment_m)
     }
 
     /// Reasons to doubt a registration on its own figures.
@@ -550,9 +620,7 @@ impl Tracker {
                 r.cost.mean
             ));
         }
-        let stalled = r.last_increment.rotation_rad.to_degrees() > l.max_final_increment_deg
-            || r.last_increment.translation_m > l.max_final_increment_m;
-        if !r.converged && stalled {
+        if self.stalled(r) {
             reasons.push(format!(
                 "no convergence after {} iterations (last step {:.2} deg, {:.3} m)",
                 r.iterations,
@@ -598,6 +666,7 @@ impl Tracker {
                 total_ms: ms(started),
                 ..Timings::default()
             },
+            fallback: false,
         }
     }
 }

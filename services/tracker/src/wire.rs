@@ -134,6 +134,7 @@ mod tests {
                 registration_ms: 2.0,
                 total_ms: 3.5,
             },
+            fallback: false,
         };
         fill_estimate(&mut e, &out);
         assert_eq!(e.wire_status().unwrap(), WireStatus::Degraded);

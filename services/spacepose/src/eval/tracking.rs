@@ -120,6 +120,9 @@ pub struct FrameRecord {
     /// even when fully converged (see [`blur_lag_deg`]). The same in every
     /// mode.
     pub blur_lag_deg: f64,
+    /// `ct-ndt` mode: CT-NDT stalled and the frame was fitted as `deblur`
+    /// fits it (`TrackerConfig::ct_ndt_stall_fallback`).
+    pub fallback: bool,
 }
 
 /// Summary of one mode (the columns of seed 000 Tables 2-3).
@@ -145,6 +148,8 @@ pub struct ModeReport {
     pub degraded_frames: usize,
     /// Frames whose true error exceeded 10° or 50 cm (including lost ones).
     pub diverged_frames: usize,
+    /// Frames fitted by the stall fallback (`ct-ndt` mode).
+    pub fallback_frames: usize,
     /// Frames run.
     pub frames: usize,
     /// Per-frame records.
@@ -363,6 +368,7 @@ fn track_frame(tracker: &mut Tracker, frame: &Frame, index: usize) -> Result<Fra
             .as_ref()
             .map_or(0, |r| r.degenerate_directions),
         blur_lag_deg: f64::NAN,
+        fallback: out.fallback,
         weakest_lever_arm_m: out
             .registration
             .as_ref()
@@ -394,6 +400,7 @@ fn summarise(series: Vec<FrameRecord>, warmup: usize) -> ModeReport {
         lost_frames: count(TrackStatus::Lost),
         degraded_frames: count(TrackStatus::Degraded),
         diverged_frames: diverged,
+        fallback_frames: series.iter().filter(|r| r.fallback).count(),
         frames: series.len(),
         series,
     }
@@ -468,6 +475,17 @@ pub fn render(report: &TrackingReport) -> String {
             "-".into(),
         ]);
     }
+    let fallbacks: String = report
+        .modes
+        .iter()
+        .filter(|(_, m)| m.fallback_frames > 0)
+        .map(|(name, m)| {
+            format!(
+                "{name}: {} frames fitted as deblur after CT-NDT stalled\n",
+                m.fallback_frames
+            )
+        })
+        .collect();
     format!(
         "{} with {}: {} frames from frame {} (seed {}, compression {}), {:.0} raw points per frame on average\n\
          errors in deg and cm; time in ms per frame, one thread, voxel filter included;\n\
@@ -485,7 +503,7 @@ pub fn render(report: &TrackingReport) -> String {
         report.blur_lag_deg.mean,
         report.blur_lag_deg.max,
         t.render()
-    )
+    ) + &fallbacks
 }
 
 /// Runs the command.
