@@ -409,7 +409,10 @@ pub struct CtPriors {
 /// turn and a [`DisplacementPrior`] on the displacement over the scan as
 /// well (with both, the start prior may be zero: the points then fix the
 /// pose, the priors its motion over the scan). The reported information of `T^e` includes
-/// both priors (start marginalised out). Same errors, plus an invalid
+/// both priors (start marginalised out). With a motion prior the first
+/// increments use every `coarse_stride`-th point, as NDT's coarse phase,
+/// until both increments fall below `coarse_switch` times their
+/// thresholds; convergence is tested on every point. Same errors, plus an invalid
 /// rate prior.
 pub fn register_ct_ndt_with_priors(
     map: &NdtMap,
@@ -469,14 +472,35 @@ pub fn register_ct_ndt_with_priors(
     let (mut start, mut end) = (prior.t_target_sensor, *initial_t_target_sensor_end);
     let (mut iterations, mut last) = (0, Increment::default());
     let mut final_joint = None;
-    // Every point from the first iteration: NDT's coarse phase (a strided
-    // subsample) left the start pose 2 cm from the full-resolution optimum
-    // along its weak directions (benchmark frame), and the fine phase spent
-    // five iterations bringing it back.
+    // Under the start prior alone, every point from the first iteration:
+    // NDT's coarse phase (a strided subsample) left the start pose 2 cm from
+    // the full-resolution optimum along its weak directions (benchmark
+    // frame), and the fine phase spent five iterations bringing it back.
+    // With a motion prior the start pose is tied to the end pose, and the
+    // coarse phase runs as in NDT (`coarse_stride`, `coarse_switch`), the
+    // data term scaled by the stride so that it weighs against the priors
+    // as the full cloud does.
+    let has_motion_prior = priors.rate.is_some() || priors.displacement.is_some();
+    let mut stride = if has_motion_prior {
+        params.coarse_stride.max(1)
+    } else {
+        1
+    };
+    let mut coarse: Vec<(Vector3<f64>, f64)> = points.iter().step_by(stride).copied().collect();
     for it in 0..params.max_iterations {
-        let mut joint = linearise(map, &points, &start, &end, params);
+        let subset = if stride > 1 { &coarse } else { &points };
+        let mut joint = linearise(map, subset, &start, &end, params);
+        if joint.inliers < 12 && stride > 1 {
+            // Too sparse a subset: continue on every point.
+            (stride, coarse) = (1, Vec::new());
+            joint = linearise(map, &points, &start, &end, params);
+        }
         if joint.inliers == 0 {
             return Err(no_match(it));
+        }
+        if stride > 1 {
+            joint.h *= stride as f64;
+            joint.g *= stride as f64;
         }
         let data_only = (joint.cost, joint.squared_distance);
         add_priors(&mut joint, &start, &end);
@@ -495,6 +519,14 @@ pub fn register_ct_ndt_with_priors(
         // Both at 1× waited for twelve increments to fall below the
         // thresholds together, while association changes keep them
         // chattering at about 1 mm.
+        if stride > 1 {
+            if below(&inc_e, params.coarse_switch)
+                && below(&inc_s, params.coarse_switch * START_TOLERANCE)
+            {
+                (stride, coarse) = (1, Vec::new());
+            }
+            continue;
+        }
         if below(&inc_e, 1.0) && below(&inc_s, START_TOLERANCE) {
             final_joint = Some(joint);
             break;
