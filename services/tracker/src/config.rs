@@ -163,8 +163,9 @@ pub struct TrackerConfig {
     /// result is assessed and fused instead, and flagged
     /// ([`crate::TrackOutput::fallback`]). Not in the paper. Without it such
     /// a frame is reported `degraded` with CT-NDT's pose: tumbling seed 13,
-    /// frame 84 (2,148 points), 4.50°; with it 2.69° (the one-pose fit
-    /// stalled too, so the frame stays `degraded` and is not fused).
+    /// frame 84 (2,148 points), 4.50°; with it 2.69°, 3.70° since the
+    /// motion prior's coarse phase (the one-pose fit stalls too, so the
+    /// frame stays `degraded` and is not fused).
     /// Default true.
     pub ct_ndt_stall_fallback: bool,
     /// Relative-motion filter tuning.
