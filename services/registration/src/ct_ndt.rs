@@ -15,6 +15,7 @@ use spacepose_geometry::{Point, Pose, so3};
 
 mod displacement_prior;
 mod free_start;
+mod joint;
 mod rate_prior;
 pub use displacement_prior::DisplacementPrior;
 pub use free_start::{

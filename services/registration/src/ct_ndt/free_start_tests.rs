@@ -1,10 +1,13 @@
 use super::*;
+use crate::ct_ndt::joint::{Matrix12, Vector12};
 use crate::ct_ndt::{
     Interpolation, ct_point_jacobian, exp_coefficients, interpolate, register_ct_ndt,
 };
 use crate::test_support::{map, perturb, rng, target, true_t_sensor_target};
 use nalgebra::Matrix3x6;
+use nalgebra::{Matrix3, SMatrix, Vector3, Vector6};
 use rand::RngExt;
+use spacepose_geometry::so3;
 
 /// The start-pose Jacobian is Eq. (15) with the ends swapped, and equals
 /// `J^total − J^e` as `linearise` computes it.
