@@ -399,47 +399,13 @@ fn icp_loop(
     check_pose("initial_t_target_sensor", initial_t_target_sensor)?;
     let (mut points, skipped) = finite_positions(source)?;
     spatial_order(&mut points, initial_t_target_sensor);
-    let max2 = params.max_distance_m * params.max_distance_m;
-    let far = params
-        .far_lookup_from_m
-        .is_some_and(|from| params.max_distance_m >= from);
-    let no_match = |iteration| RegistrationError::NoCorrespondences {
-        iteration,
-        max_distance_m: params.max_distance_m,
-    };
-    // Within the grid's distance every lookup goes through a memo per
-    // point (see `nearest_memo`: exact, and most late lookups reuse it).
-    let memoised =
-        params.lookup == CellLookup::Grid && params.max_distance_m <= model.grid.max_distance;
-    let mut memos = vec![NearestMemo::default(); if memoised { points.len() } else { 0 }];
+    let mut run = IcpRun::new(model, &points, params);
     let mut pose = *initial_t_target_sensor;
     let (mut converged, mut iterations, mut last) = (false, 0, Increment::default());
     for it in 0..params.max_iterations {
-        let mut pairs = Pairs {
-            x_sum: Vector3::zeros(),
-            m_sum: Vector3::zeros(),
-            cross: Matrix3::zeros(),
-            count: 0,
-        };
-        let rotation = pose.rotation.matrix();
-        for (i, z) in points.iter().enumerate() {
-            let x = rotation * z + pose.translation;
-            let hit = if memoised {
-                model
-                    .grid
-                    .nearest_within_memo(&x, max2, &mut memos[i], counts)
-            } else {
-                model.nearest_within(&x, params.max_distance_m, params.lookup, far)
-            };
-            if let Some((m, _)) = hit {
-                pairs.x_sum += x;
-                pairs.m_sum += m;
-                pairs.cross += m * x.transpose();
-                pairs.count += 1;
-            }
-        }
+        let pairs = run.pairs(&pose, counts);
         if pairs.count == 0 {
-            return Err(no_match(it));
+            return Err(run.no_match(it));
         }
         let (dr, dp) = kabsch(&pairs).ok_or(RegistrationError::DegenerateSystem {
             iteration: it,
@@ -460,32 +426,9 @@ fn icp_loop(
             break;
         }
     }
-    // Final evaluation at the returned pose (through the far lookup when
-    // the iterations used it: a wide stage's cost and f_CONV only rank
-    // and chain stages, and exact searches here cost more than its
-    // approximate iterations).
-    let mut ne = NormalEquations::new();
-    let mut all_d2 = 0.0;
-    let identity = Matrix3::identity();
-    let grid_max2 = model.grid.max_distance * model.grid.max_distance;
-    for (i, z) in points.iter().enumerate() {
-        let rz = pose.rotation * z;
-        let x = rz + pose.translation;
-        let (m, d2) = match memos.get_mut(i) {
-            // The grid's answer within its distance, as `nearest_any`'s.
-            Some(memo) => model
-                .grid
-                .nearest_within_memo(&x, grid_max2, memo, counts)
-                .unwrap_or_else(|| model.nearest_beyond_grid(&x, far)),
-            None => model.nearest_any(&x, params.lookup, far),
-        };
-        all_d2 += d2;
-        if d2 <= max2 {
-            ne.add_rigid(&rz, &identity, &(x - m));
-        }
-    }
+    let (ne, all_d2) = run.final_evaluation(&pose, counts);
     if ne.inliers == 0 {
-        return Err(no_match(iterations));
+        return Err(run.no_match(iterations));
     }
     let n = ne.inliers as f64;
     let sigma2 = params.point_sigma_m * params.point_sigma_m;
@@ -508,6 +451,106 @@ fn icp_loop(
         weakest_lever_arm_m: f64::NAN,
         geometric_information: None,
     })
+}
+
+/// The correspondence search of one ICP registration: the model, the
+/// (spatially ordered) source points and, within the grid's distance, a
+/// nearest-neighbour memo per point.
+struct IcpRun<'a> {
+    model: &'a IcpModel,
+    points: &'a [Vector3<f64>],
+    params: &'a IcpParams,
+    /// Squared maximum correspondence distance (m²).
+    max2: f64,
+    /// Lookups beyond `far_lookup_from_m` go through the far lookup.
+    far: bool,
+    /// One memo per point when memoised (see `nearest_memo`: exact, and
+    /// most late lookups reuse it); empty otherwise.
+    memos: Vec<NearestMemo>,
+}
+
+impl<'a> IcpRun<'a> {
+    fn new(model: &'a IcpModel, points: &'a [Vector3<f64>], params: &'a IcpParams) -> Self {
+        let far = params
+            .far_lookup_from_m
+            .is_some_and(|from| params.max_distance_m >= from);
+        // Within the grid's distance every lookup goes through a memo.
+        let memoised =
+            params.lookup == CellLookup::Grid && params.max_distance_m <= model.grid.max_distance;
+        let memos = vec![NearestMemo::default(); if memoised { points.len() } else { 0 }];
+        Self {
+            model,
+            points,
+            params,
+            max2: params.max_distance_m * params.max_distance_m,
+            far,
+            memos,
+        }
+    }
+
+    fn no_match(&self, iteration: usize) -> RegistrationError {
+        RegistrationError::NoCorrespondences {
+            iteration,
+            max_distance_m: self.params.max_distance_m,
+        }
+    }
+
+    /// The sums over every point whose nearest model point at `pose` is
+    /// within the maximum correspondence distance.
+    fn pairs(&mut self, pose: &Pose, counts: &mut MemoCounts) -> Pairs {
+        let mut pairs = Pairs {
+            x_sum: Vector3::zeros(),
+            m_sum: Vector3::zeros(),
+            cross: Matrix3::zeros(),
+            count: 0,
+        };
+        let rotation = pose.rotation.matrix();
+        let (model, params) = (self.model, self.params);
+        for (i, z) in self.points.iter().enumerate() {
+            let x = rotation * z + pose.translation;
+            let hit = match self.memos.get_mut(i) {
+                Some(memo) => model.grid.nearest_within_memo(&x, self.max2, memo, counts),
+                None => model.nearest_within(&x, params.max_distance_m, params.lookup, self.far),
+            };
+            if let Some((m, _)) = hit {
+                pairs.x_sum += x;
+                pairs.m_sum += m;
+                pairs.cross += m * x.transpose();
+                pairs.count += 1;
+            }
+        }
+        pairs
+    }
+
+    /// Final evaluation at the returned pose: the normal equations over the
+    /// inliers and `Σ d²` over every point (f_CONV's numerator). Through the
+    /// far lookup when the iterations used it: a wide stage's cost and
+    /// f_CONV only rank and chain stages, and exact searches here cost more
+    /// than its approximate iterations.
+    fn final_evaluation(&mut self, pose: &Pose, counts: &mut MemoCounts) -> (NormalEquations, f64) {
+        let mut ne = NormalEquations::new();
+        let mut all_d2 = 0.0;
+        let identity = Matrix3::identity();
+        let model = self.model;
+        let grid_max2 = model.grid.max_distance * model.grid.max_distance;
+        for (i, z) in self.points.iter().enumerate() {
+            let rz = pose.rotation * z;
+            let x = rz + pose.translation;
+            let (m, d2) = match self.memos.get_mut(i) {
+                // The grid's answer within its distance, as `nearest_any`'s.
+                Some(memo) => model
+                    .grid
+                    .nearest_within_memo(&x, grid_max2, memo, counts)
+                    .unwrap_or_else(|| model.nearest_beyond_grid(&x, self.far)),
+                None => model.nearest_any(&x, self.params.lookup, self.far),
+            };
+            all_d2 += d2;
+            if d2 <= self.max2 {
+                ne.add_rigid(&rz, &identity, &(x - m));
+            }
+        }
+        (ne, all_d2)
+    }
 }
 
 #[cfg(test)]
