@@ -159,17 +159,7 @@ impl Tracker {
     ) -> Result<TrackOutput, TrackError> {
         let started = Instant::now();
         let last = self.last.ok_or(TrackError::NotInitialized)?;
-        if !(scan_start.is_finite()
-            && scan_end.is_finite()
-            && scan_start <= scan_end
-            && scan_end > last.t)
-        {
-            return Err(TrackError::InvalidScanTimes {
-                start_s: scan_start,
-                end_s: scan_end,
-                previous_end_s: Some(last.t),
-            });
-        }
+        check_scan_times(scan_start, scan_end, last.t)?;
         let prediction = self.filter.predict_at(scan_end)?;
         if self.lost {
             return Ok(self.lost_output(
@@ -195,15 +185,12 @@ impl Tracker {
                 self.config.loss.min_points
             );
             let mut out = self.declare_lost(&prediction, points.len(), reason, started);
-            out.points_used = cloud.len();
-            out.timings.preprocess_ms = preprocess_ms;
+            (out.points_used, out.timings.preprocess_ms) = (cloud.len(), preprocess_ms);
             return Ok(out);
         }
         let reg_start = Instant::now();
-        let scan = ScanTimes {
-            start_s: scan_start,
-            end_s: scan_end,
-        };
+        let (start_s, end_s) = (scan_start, scan_end);
+        let scan = ScanTimes { start_s, end_s };
         let registration = match self.register(&cloud, compensated, &prediction, &last, &scan) {
             Ok(r) => r,
             Err(e) => {
@@ -688,6 +675,20 @@ fn weakest_rotation(h: &Matrix6<f64>) -> Option<Vector3<f64>> {
 
 fn ms(since: Instant) -> f64 {
     since.elapsed().as_secs_f64() * 1e3
+}
+
+/// Rejects non-finite or reversed scan times, and a scan that does not end
+/// after the previous one (`previous_end_s`).
+fn check_scan_times(start_s: f64, end_s: f64, previous_end_s: f64) -> Result<(), TrackError> {
+    if start_s.is_finite() && end_s.is_finite() && start_s <= end_s && end_s > previous_end_s {
+        Ok(())
+    } else {
+        Err(TrackError::InvalidScanTimes {
+            start_s,
+            end_s,
+            previous_end_s: Some(previous_end_s),
+        })
+    }
 }
 
 #[cfg(test)]
