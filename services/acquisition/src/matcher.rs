@@ -17,9 +17,13 @@ use spacepose_geometry::{Euler321, Point, Pose, so3};
 use spacepose_lidar_sim::{LidarSimulator, SensorConfig};
 use spacepose_registration::IcpModel;
 use spacepose_target::Target;
+use stages::Timing;
 use std::f64::consts::PI;
 use std::sync::Arc;
 use std::time::Instant;
+
+#[path = "matcher_stages.rs"]
+mod stages;
 
 /// Seed of the model-cloud sampling (any fixed value: the cloud is deterministic).
 const MODEL_SEED: u64 = 0x5eed_0002;
@@ -188,183 +192,21 @@ impl TemplateMatcher {
     /// not accepted.
     pub fn acquire(&self, cloud: &[Point]) -> Result<AcquisitionOutcome, AcquisitionError> {
         let start = Instant::now();
-        let finite: Vec<Point> = cloud.iter().copied().filter(Point::is_finite).collect();
-        if finite.len() < self.config.min_points {
-            return Err(AcquisitionError::TooFewPoints {
-                valid: finite.len(),
-                total: cloud.len(),
-                required: self.config.min_points,
-            });
-        }
-        let positions: Vec<Vector3<f64>> = finite.iter().map(Point::position).collect();
-        let centering = if self.config.trimmed_centroid {
-            Centering::Trimmed(self.config.trim)
-        } else {
-            Centering::Mean
-        };
-        let mut scratch = Vec::new();
-        let centre =
-            centering
-                .centre(&positions, &mut scratch)
-                .ok_or(AcquisitionError::TooFewPoints {
-                    valid: 0,
-                    total: cloud.len(),
-                    required: self.config.min_points,
-                })?;
-        let correlator = Correlator::new(
-            &positions,
-            &centre,
-            centering,
-            self.config.max_correlation_points,
-            self.config.symmetric_correlation,
-        );
-        let sensed = Sensed {
-            correlator: &correlator,
-            centre,
-            d_bor: d_bor(&positions),
-        };
-        let (ranked, generated, rejected) = self.match_templates(&sensed);
-        // Correlations computed at full resolution (the fine pass only,
-        // with coarse-to-fine).
-        let evaluated = match self.config.coarse_to_fine {
-            Some(c) if self.coarse_renderer.is_some() => ranked.len().min(c.keep),
-            _ => ranked.len(),
-        };
-        let Some(&(_, best_c, _)) = ranked.first() else {
-            return Err(AcquisitionError::NoTemplate {
-                generated,
-                rejected,
-            });
-        };
+        let frame = self.prepare(cloud)?;
+        let matched = self.match_frame(&frame)?;
         let matching_ms = ms_since(start);
 
         // Template solution(s): grid attitude, origin from the centroid alignment.
         let refine_start = Instant::now();
-        let sensed_tree = SensedTree::new(&positions);
-        let (mut candidates, starts, screened) = self.screened_candidates(
-            &ranked,
-            &finite,
-            (&positions, &centre),
-            centering,
-            &sensed_tree,
-        );
-        // After screening, the wide stages have been run: only the
-        // narrowest is repeated, on the full model, before the final one.
-        let stages = &self.config.icp_stages_m;
-        let stages = match screened {
-            0 => &stages[..],
-            _ => &stages[stages.len().saturating_sub(1)..],
-        };
-        let mut refined: Vec<Result<Refined, String>> = starts
-            .iter()
-            .map(|pose| {
-                refine_with_stages(
-                    &self.icp_model,
-                    self.stage_model(),
-                    &finite,
-                    pose,
-                    &self.config,
-                    stages,
-                )
-                .map_err(|e| e.to_string())
-            })
-            .collect();
-        let mut unexplained: Vec<f64> = refined
-            .iter()
-            .map(|r| match r {
-                Ok(r) => self.unexplained(&sensed_tree, &r.t_sensor_target),
-                Err(_) => 1.0,
-            })
-            .collect();
-        let w = self.config.unexplained_weight_m2;
-        let first_best = refined
-            .iter()
-            .zip(&unexplained)
-            .enumerate()
-            .filter_map(|(i, (r, &u))| r.as_ref().ok().map(|r| (i, r, u)))
-            .min_by(|a, b| (a.1.msd_all_m2 + w * a.2).total_cmp(&(b.1.msd_all_m2 + w * b.2)));
-        if let Some((i, r, u)) = first_best
-            && self.config.revote
-            // The uncapped f_CONV decides whether to try again: a flip can
-            // fit most points and still leave a few far off.
-            && !self.acceptable(r.msd_all_m2, u)
-        {
-            for (again, u_again) in
-                self.second_chance(&r.t_sensor_target, &finite, &positions, &sensed_tree)
-            {
-                refined.push(Ok(again));
-                unexplained.push(u_again);
-                candidates.push(candidates[i]);
-            }
-        }
-        let refinement_ms = ms_since(refine_start);
-        let score = |i: usize, r: &Refined| {
-            if w > 0.0 {
-                r.msd_all_m2 + w * unexplained[i]
-            } else {
-                r.msd_all_m2
-            }
-        };
-        let best = refined
-            .iter()
-            .enumerate()
-            .filter_map(|(i, r)| r.as_ref().ok().map(|r| (i, r)))
-            .min_by(|a, b| score(a.0, a.1).total_cmp(&score(b.0, b.1)));
-        let coarse_of = |rank: usize| candidates[rank].1;
-        let c_of = |rank: usize| {
-            let k = candidates[rank].0;
-            ranked.iter().find(|r| r.0 == k).map_or(best_c, |r| r.1)
-        };
-        let (chosen_rank, pose, f_conv, iterations, converged, inliers, refinement_error) =
-            match best {
-                Some((i, r)) => (
-                    i,
-                    r.t_sensor_target,
-                    r.f_conv_m2,
-                    r.iterations,
-                    r.converged,
-                    r.inlier_fraction,
-                    None,
-                ),
-                None => (
-                    0,
-                    coarse_of(0),
-                    f64::INFINITY,
-                    0,
-                    false,
-                    0.0,
-                    refined.first().and_then(|r| r.as_ref().err().cloned()),
-                ),
-            };
-        let unexplained_fraction = match best {
-            Some((i, _)) => unexplained[i],
-            None => 1.0,
-        };
-        let chosen_k = candidates[chosen_rank].0;
-        Ok(AcquisitionOutcome {
-            t_sensor_target: pose,
-            t_sensor_target_coarse: coarse_of(chosen_rank),
-            euler_coarse: self.grid[chosen_k].0,
-            centroid_m: [centre.x, centre.y, centre.z],
-            correlation_m2: c_of(chosen_rank),
-            f_conv_m2: f_conv,
-            unexplained_fraction,
-            accepted: self.acceptable(f_conv, unexplained_fraction),
-            templates_generated: generated,
-            templates_evaluated: evaluated,
-            templates_rejected: rejected,
-            points_used: finite.len(),
-            time_ms: ms_since(start),
+        let sensed_tree = SensedTree::new(&frame.positions);
+        let mut refinements = self.refine_candidates(&matched.ranked, &frame, &sensed_tree);
+        self.add_second_chance(&mut refinements, &frame, &sensed_tree);
+        let timing = Timing {
+            start,
             matching_ms,
-            refinement_ms,
-            candidates_refined: candidates.len(),
-            candidates_screened: screened,
-            chosen_rank,
-            icp_iterations: iterations,
-            icp_converged: converged,
-            icp_inlier_fraction: inliers,
-            refinement_error,
-        })
+            refinement_ms: ms_since(refine_start),
+        };
+        Ok(self.outcome(&frame, &matched, &refinements, timing))
     }
 
     /// The candidates to refine, `(grid index, template pose)`, the poses

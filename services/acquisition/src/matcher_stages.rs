@@ -1,0 +1,355 @@
+//! The stages of one [`TemplateMatcher::acquire`] call, in order: the
+//! frame's finite points and centre, template matching (seed 002 §2),
+//! ICP refinement of the candidates with the second chance, and the
+//! outcome with the f_CONV check (§4.5).
+
+use super::{Ranked, Sensed, TemplateMatcher, ms_since};
+use crate::correlation::{Centering, Correlator, d_bor};
+use crate::error::AcquisitionError;
+use crate::outcome::AcquisitionOutcome;
+use crate::refine::{Refined, refine_with_stages};
+use crate::visibility::SensedTree;
+use nalgebra::Vector3;
+use spacepose_geometry::{Point, Pose};
+use std::time::Instant;
+
+/// One frame's finite points and the centre they are matched at.
+pub(super) struct Frame {
+    /// The finite points of the cloud.
+    pub(super) finite: Vec<Point>,
+    /// Their positions (sensor frame).
+    pub(super) positions: Vec<Vector3<f64>>,
+    /// How the centre is taken, for the sensed cloud and the templates.
+    centering: Centering,
+    /// The position estimate of seed 002 §2.1: the (trimmed) centroid.
+    centre: Vector3<f64>,
+}
+
+/// The template-matching result of one frame.
+pub(super) struct Matched {
+    /// The scored templates, best C first (see `match_templates`).
+    pub(super) ranked: Vec<Ranked>,
+    /// Templates rendered.
+    generated: usize,
+    /// Templates rejected by Eq. (3).
+    rejected: usize,
+    /// Correlations computed at full resolution.
+    evaluated: usize,
+    /// C of the best template.
+    best_c: f64,
+}
+
+/// The ICP refinements of one frame's candidates; `candidates`, `refined`
+/// and `unexplained` are index-aligned (index = rank).
+pub(super) struct Refinements {
+    /// `(grid index, template pose)` of each refinement.
+    candidates: Vec<(usize, Pose)>,
+    /// The refinement results (errors as their messages).
+    refined: Vec<Result<Refined, String>>,
+    /// Unexplained fraction of each result (1 for a failed refinement).
+    unexplained: Vec<f64>,
+    /// Candidates screened by a short ICP (0 when screening is off).
+    screened: usize,
+}
+
+/// The chosen solution: the winning refinement, or the first candidate's
+/// template pose when every refinement failed.
+struct Chosen {
+    /// Index of the winning candidate in [`Refinements`].
+    rank: usize,
+    /// The refined pose (the template pose if every refinement failed).
+    pose: Pose,
+    /// f_CONV (m²), infinite if every refinement failed.
+    f_conv_m2: f64,
+    /// ICP iterations over all stages.
+    iterations: usize,
+    /// The final ICP stage converged.
+    converged: bool,
+    /// Inlier fraction of the final ICP stage.
+    inlier_fraction: f64,
+    /// Unexplained fraction, 1 if every refinement failed.
+    unexplained_fraction: f64,
+    /// The first candidate's refinement error if every refinement failed.
+    refinement_error: Option<String>,
+}
+
+/// Wall times of one acquisition.
+#[derive(Clone, Copy)]
+pub(super) struct Timing {
+    /// When the acquisition started.
+    pub(super) start: Instant,
+    /// Template matching (ms).
+    pub(super) matching_ms: f64,
+    /// ICP refinement (ms).
+    pub(super) refinement_ms: f64,
+}
+
+impl Matched {
+    /// C of grid template `k` (the best C if `k` was not ranked).
+    fn correlation_of(&self, k: usize) -> f64 {
+        self.ranked
+            .iter()
+            .find(|r| r.0 == k)
+            .map_or(self.best_c, |r| r.1)
+    }
+}
+
+impl Refinements {
+    /// The successful refinement with the lowest uncapped f_CONV plus `w`
+    /// times its unexplained fraction: `(index, result, unexplained)`.
+    fn first_best(&self, w: f64) -> Option<(usize, &Refined, f64)> {
+        self.refined
+            .iter()
+            .zip(&self.unexplained)
+            .enumerate()
+            .filter_map(|(i, (r, &u))| r.as_ref().ok().map(|r| (i, r, u)))
+            .min_by(|a, b| (a.1.msd_all_m2 + w * a.2).total_cmp(&(b.1.msd_all_m2 + w * b.2)))
+    }
+
+    /// The successful refinement with the lowest uncapped f_CONV, plus `w`
+    /// times its unexplained fraction when `w > 0`: `(index, result)`.
+    fn best(&self, w: f64) -> Option<(usize, &Refined)> {
+        let score = |i: usize, r: &Refined| {
+            if w > 0.0 {
+                r.msd_all_m2 + w * self.unexplained[i]
+            } else {
+                r.msd_all_m2
+            }
+        };
+        self.refined
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| r.as_ref().ok().map(|r| (i, r)))
+            .min_by(|a, b| score(a.0, a.1).total_cmp(&score(b.0, b.1)))
+    }
+
+    /// The chosen solution (see [`Refinements::best`], weight `w`); when
+    /// every refinement failed, the first candidate's template pose with
+    /// f_CONV infinite, unexplained fraction 1 and the first error.
+    fn choose(&self, w: f64) -> Chosen {
+        match self.best(w) {
+            Some((i, r)) => Chosen {
+                rank: i,
+                pose: r.t_sensor_target,
+                f_conv_m2: r.f_conv_m2,
+                iterations: r.iterations,
+                converged: r.converged,
+                inlier_fraction: r.inlier_fraction,
+                unexplained_fraction: self.unexplained[i],
+                refinement_error: None,
+            },
+            None => Chosen {
+                rank: 0,
+                pose: self.candidates[0].1,
+                f_conv_m2: f64::INFINITY,
+                iterations: 0,
+                converged: false,
+                inlier_fraction: 0.0,
+                unexplained_fraction: 1.0,
+                refinement_error: self.refined.first().and_then(|r| r.as_ref().err().cloned()),
+            },
+        }
+    }
+}
+
+impl TemplateMatcher {
+    /// The finite points of `cloud`, their positions and centre.
+    /// [`AcquisitionError::TooFewPoints`] with fewer than `min_points`
+    /// finite points, or when the centre cannot be taken (`valid: 0`).
+    pub(super) fn prepare(&self, cloud: &[Point]) -> Result<Frame, AcquisitionError> {
+        let finite: Vec<Point> = cloud.iter().copied().filter(Point::is_finite).collect();
+        if finite.len() < self.config.min_points {
+            return Err(AcquisitionError::TooFewPoints {
+                valid: finite.len(),
+                total: cloud.len(),
+                required: self.config.min_points,
+            });
+        }
+        let positions: Vec<Vector3<f64>> = finite.iter().map(Point::position).collect();
+        let centering = self.centering();
+        let mut scratch = Vec::new();
+        let centre =
+            centering
+                .centre(&positions, &mut scratch)
+                .ok_or(AcquisitionError::TooFewPoints {
+                    valid: 0,
+                    total: cloud.len(),
+                    required: self.config.min_points,
+                })?;
+        Ok(Frame {
+            finite,
+            positions,
+            centering,
+            centre,
+        })
+    }
+
+    /// The centring of clouds and templates: the centroid trimmed by
+    /// `trim` when `trimmed_centroid` is set, else the mean.
+    fn centering(&self) -> Centering {
+        if self.config.trimmed_centroid {
+            Centering::Trimmed(self.config.trim)
+        } else {
+            Centering::Mean
+        }
+    }
+
+    /// Template matching of `frame` (seed 002 §2): the templates scored by
+    /// C of Eq. (1) against the sensed points (see `match_templates`).
+    /// [`AcquisitionError::NoTemplate`] when no template was correlated.
+    pub(super) fn match_frame(&self, frame: &Frame) -> Result<Matched, AcquisitionError> {
+        let correlator = Correlator::new(
+            &frame.positions,
+            &frame.centre,
+            frame.centering,
+            self.config.max_correlation_points,
+            self.config.symmetric_correlation,
+        );
+        let sensed = Sensed {
+            correlator: &correlator,
+            centre: frame.centre,
+            d_bor: d_bor(&frame.positions),
+        };
+        let (ranked, generated, rejected) = self.match_templates(&sensed);
+        // Correlations computed at full resolution (the fine pass only,
+        // with coarse-to-fine).
+        let evaluated = match self.config.coarse_to_fine {
+            Some(c) if self.coarse_renderer.is_some() => ranked.len().min(c.keep),
+            _ => ranked.len(),
+        };
+        let Some(&(_, best_c, _)) = ranked.first() else {
+            return Err(AcquisitionError::NoTemplate {
+                generated,
+                rejected,
+            });
+        };
+        Ok(Matched {
+            ranked,
+            generated,
+            rejected,
+            evaluated,
+            best_c,
+        })
+    }
+
+    /// The candidates of `ranked` (see `screened_candidates`) refined by
+    /// ICP on every finite point of `frame`, each with its unexplained
+    /// fraction against `sensed_tree` (1 for a failed refinement).
+    pub(super) fn refine_candidates(
+        &self,
+        ranked: &[Ranked],
+        frame: &Frame,
+        sensed_tree: &SensedTree,
+    ) -> Refinements {
+        let (candidates, starts, screened) = self.screened_candidates(
+            ranked,
+            &frame.finite,
+            (&frame.positions, &frame.centre),
+            frame.centering,
+            sensed_tree,
+        );
+        // After screening, the wide stages have been run: only the
+        // narrowest is repeated, on the full model, before the final one.
+        let stages = &self.config.icp_stages_m;
+        let stages = match screened {
+            0 => &stages[..],
+            _ => &stages[stages.len().saturating_sub(1)..],
+        };
+        let refined: Vec<Result<Refined, String>> = starts
+            .iter()
+            .map(|pose| {
+                refine_with_stages(
+                    &self.icp_model,
+                    self.stage_model(),
+                    &frame.finite,
+                    pose,
+                    &self.config,
+                    stages,
+                )
+                .map_err(|e| e.to_string())
+            })
+            .collect();
+        let unexplained: Vec<f64> = refined
+            .iter()
+            .map(|r| match r {
+                Ok(r) => self.unexplained(sensed_tree, &r.t_sensor_target),
+                Err(_) => 1.0,
+            })
+            .collect();
+        Refinements {
+            candidates,
+            refined,
+            unexplained,
+            screened,
+        }
+    }
+
+    /// The second chance (see [`crate::TemplateMatchingConfig::revote`]):
+    /// when `revote` is on and the best refinement (see
+    /// [`Refinements::first_best`]) fails the acceptance test, each attempt
+    /// of `second_chance` is appended as a refinement of that candidate.
+    pub(super) fn add_second_chance(
+        &self,
+        refinements: &mut Refinements,
+        frame: &Frame,
+        sensed_tree: &SensedTree,
+    ) {
+        let w = self.config.unexplained_weight_m2;
+        if let Some((i, r, u)) = refinements.first_best(w)
+            && self.config.revote
+            // The uncapped f_CONV decides whether to try again: a flip can
+            // fit most points and still leave a few far off.
+            && !self.acceptable(r.msd_all_m2, u)
+        {
+            for (again, u_again) in self.second_chance(
+                &r.t_sensor_target,
+                &frame.finite,
+                &frame.positions,
+                sensed_tree,
+            ) {
+                refinements.refined.push(Ok(again));
+                refinements.unexplained.push(u_again);
+                refinements.candidates.push(refinements.candidates[i]);
+            }
+        }
+    }
+
+    /// The outcome of one acquisition: the chosen solution (see
+    /// [`Refinements::choose`]), its template and the f_CONV check
+    /// (seed 002 §4.5), with the counts and wall times of the stages.
+    pub(super) fn outcome(
+        &self,
+        frame: &Frame,
+        matched: &Matched,
+        refinements: &Refinements,
+        timing: Timing,
+    ) -> AcquisitionOutcome {
+        let chosen = refinements.choose(self.config.unexplained_weight_m2);
+        let (chosen_k, coarse) = refinements.candidates[chosen.rank];
+        let centre = frame.centre;
+        AcquisitionOutcome {
+            t_sensor_target: chosen.pose,
+            t_sensor_target_coarse: coarse,
+            euler_coarse: self.grid[chosen_k].0,
+            centroid_m: [centre.x, centre.y, centre.z],
+            correlation_m2: matched.correlation_of(chosen_k),
+            f_conv_m2: chosen.f_conv_m2,
+            unexplained_fraction: chosen.unexplained_fraction,
+            accepted: self.acceptable(chosen.f_conv_m2, chosen.unexplained_fraction),
+            templates_generated: matched.generated,
+            templates_evaluated: matched.evaluated,
+            templates_rejected: matched.rejected,
+            points_used: frame.finite.len(),
+            time_ms: ms_since(timing.start),
+            matching_ms: timing.matching_ms,
+            refinement_ms: timing.refinement_ms,
+            candidates_refined: refinements.candidates.len(),
+            candidates_screened: refinements.screened,
+            chosen_rank: chosen.rank,
+            icp_iterations: chosen.iterations,
+            icp_converged: chosen.converged,
+            icp_inlier_fraction: chosen.inlier_fraction,
+            refinement_error: chosen.refinement_error,
+        }
+    }
+}
