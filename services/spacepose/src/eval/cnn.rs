@@ -10,7 +10,7 @@
 //! simulated in parallel, chunk by chunk; the estimates then run one after
 //! the other on the calling thread, so the timings are those of one core.
 
-use super::table::{Table, num};
+use super::cnn_render;
 use crate::common::load_target;
 use crate::eval::stats::median;
 use crate::sim_cmd::progress_bar;
@@ -441,6 +441,7 @@ pub fn evaluate(args: &EvalCnnArgs) -> Result<CnnReport> {
     Ok(report(args, &estimator, &model, config, frames))
 }
 
+/// The summary of the scored `frames`.
 fn report(
     args: &EvalCnnArgs,
     estimator: &CnnEstimator,
@@ -449,197 +450,143 @@ fn report(
     frames: Vec<CnnFrame>,
 ) -> CnnReport {
     let n = frames.len().max(1) as f64;
-    let rate = |f: &dyn Fn(&CnnFrame) -> bool| frames.iter().filter(|r| f(r)).count() as f64 / n;
-    let over = |ok: &dyn Fn(&CnnFrame) -> bool, v: &dyn Fn(&CnnFrame) -> f64| {
-        MeanStd::of(&frames.iter().filter(|r| ok(r)).map(v).collect::<Vec<_>>())
-    };
-    let ok: Vec<&CnnFrame> = frames.iter().filter(|r| r.error.is_none()).collect();
-    let time =
-        |f: &dyn Fn(&CnnFrame) -> f64| TimeStats::of(&ok.iter().map(|r| f(r)).collect::<Vec<_>>());
-    let fconv = |succ: bool| -> Vec<f64> {
-        frames
-            .iter()
-            .filter(|r| r.success_refined == succ && r.f_conv_m2.is_finite())
-            .map(|r| r.f_conv_m2)
-            .collect()
-    };
-    let (s, f) = (fconv(true), fconv(false));
-    let by_range = [2.5, 5.0, 10.0, 15.0, 20.0]
-        .windows(2)
-        .map(|w| {
-            let bin: Vec<&CnnFrame> = frames
-                .iter()
-                .filter(|r| r.range_m >= w[0] && (r.range_m < w[1] || w[1] >= 20.0))
-                .collect();
-            let k = bin.len().max(1) as f64;
-            RangeBin {
-                range_m: [w[0], w[1]],
-                frames: bin.len(),
-                success_rate_refined: bin.iter().filter(|r| r.success_refined).count() as f64 / k,
-                success_rate_raw: bin.iter().filter(|r| r.success_raw).count() as f64 / k,
-            }
-        })
-        .collect();
     CnnReport {
         target: args.target.clone(),
         model: model.display().to_string(),
         engine: estimator.engine().to_string(),
         seed: args.seed,
         count: frames.len(),
-        success_rate_refined: rate(&|r| r.success_refined),
-        success_rate_raw: rate(&|r| r.success_raw),
-        ang_err_deg: RawRefined {
-            raw: over(&|r| r.success_raw, &|r| r.raw_err_deg),
-            refined: over(&|r| r.success_refined, &|r| r.err_deg),
-        },
-        pos_err_cm: RawRefined {
-            raw: over(&|r| r.success_raw, &|r| r.raw_err_cm),
-            refined: over(&|r| r.success_refined, &|r| r.err_cm),
-        },
-        time_ms: TimeSplit {
-            preprocess: time(&|r| r.time_ms.preprocess),
-            inference: time(&|r| r.time_ms.inference),
-            refinement: time(&|r| r.time_ms.refinement),
-            total: time(&|r| r.time_ms.total),
-        },
-        fconv: FconvStats {
-            f_max_m2: estimator.f_max_m2(),
-            accepted_rate: rate(&|r| r.accepted),
-            false_accepts: frames
-                .iter()
-                .filter(|r| r.accepted && !r.success_refined)
-                .count(),
-            false_rejects: frames
-                .iter()
-                .filter(|r| !r.accepted && r.success_refined)
-                .count(),
-            success_max_m2: s.iter().copied().fold(f64::NAN, f64::max),
-            success_median_m2: median(&s),
-            failure_min_m2: f.iter().copied().fold(f64::NAN, f64::min),
-            failure_median_m2: median(&f),
-        },
-        by_range,
-        errors: frames.iter().filter(|r| r.error.is_some()).count(),
-        other_hypothesis: frames.iter().filter(|r| r.hypothesis > 0).count(),
-        several_hypotheses: frames.iter().filter(|r| r.hypotheses_refined > 1).count(),
-        twins_refined: frames.iter().filter(|r| r.twins.twins_refined > 0).count(),
-        twin_used: frames.iter().filter(|r| r.twins.twin.is_some()).count(),
+        success_rate_refined: rate(&frames, |r| r.success_refined),
+        success_rate_raw: rate(&frames, |r| r.success_raw),
+        ang_err_deg: raw_refined(&frames, |r| r.raw_err_deg, |r| r.err_deg),
+        pos_err_cm: raw_refined(&frames, |r| r.raw_err_cm, |r| r.err_cm),
+        time_ms: time_split(&frames),
+        fconv: fconv_stats(&frames, estimator.f_max_m2()),
+        by_range: range_bins(&frames),
+        errors: count(&frames, |r| r.error.is_some()),
+        other_hypothesis: count(&frames, |r| r.hypothesis > 0),
+        several_hypotheses: count(&frames, |r| r.hypotheses_refined > 1),
+        twins_refined: count(&frames, |r| r.twins.twins_refined > 0),
+        twin_used: count(&frames, |r| r.twins.twin.is_some()),
         mean_points: frames.iter().map(|r| r.points as f64).sum::<f64>() / n,
         config,
         frames,
     }
 }
 
+/// Frames for which `keep` holds.
+fn count(frames: &[CnnFrame], keep: impl Fn(&CnnFrame) -> bool) -> usize {
+    frames.iter().filter(|r| keep(r)).count()
+}
+
+/// Frames for which `keep` holds over all frames (over 1 when none).
+fn rate(frames: &[CnnFrame], keep: impl Fn(&CnnFrame) -> bool) -> f64 {
+    count(frames, keep) as f64 / frames.len().max(1) as f64
+}
+
+/// Mean ± std of `value` over the frames for which `keep` holds.
+fn mean_std_over(
+    frames: &[CnnFrame],
+    keep: impl Fn(&CnnFrame) -> bool,
+    value: impl Fn(&CnnFrame) -> f64,
+) -> MeanStd {
+    MeanStd::of(
+        &frames
+            .iter()
+            .filter(|r| keep(r))
+            .map(value)
+            .collect::<Vec<_>>(),
+    )
+}
+
+/// An error before refinement over the raw successes and after it over
+/// the refined successes.
+fn raw_refined(
+    frames: &[CnnFrame],
+    raw: impl Fn(&CnnFrame) -> f64,
+    refined: impl Fn(&CnnFrame) -> f64,
+) -> RawRefined {
+    RawRefined {
+        raw: mean_std_over(frames, |r| r.success_raw, raw),
+        refined: mean_std_over(frames, |r| r.success_refined, refined),
+    }
+}
+
+/// Table IV: the time split over the frames without an error.
+fn time_split(frames: &[CnnFrame]) -> TimeSplit {
+    let ok: Vec<&CnnFrame> = frames.iter().filter(|r| r.error.is_none()).collect();
+    let time =
+        |f: fn(&CnnFrame) -> f64| TimeStats::of(&ok.iter().map(|r| f(r)).collect::<Vec<_>>());
+    TimeSplit {
+        preprocess: time(|r| r.time_ms.preprocess),
+        inference: time(|r| r.time_ms.inference),
+        refinement: time(|r| r.time_ms.refinement),
+        total: time(|r| r.time_ms.total),
+    }
+}
+
+/// The finite f_CONV values of the refined successes (`success`) or
+/// failures (`!success`).
+fn fconv_values(frames: &[CnnFrame], success: bool) -> Vec<f64> {
+    frames
+        .iter()
+        .filter(|r| r.success_refined == success && r.f_conv_m2.is_finite())
+        .map(|r| r.f_conv_m2)
+        .collect()
+}
+
+/// The acceptance check against the refined successes, with `f_max_m2`.
+fn fconv_stats(frames: &[CnnFrame], f_max_m2: f64) -> FconvStats {
+    let (s, f) = (fconv_values(frames, true), fconv_values(frames, false));
+    FconvStats {
+        f_max_m2,
+        accepted_rate: rate(frames, |r| r.accepted),
+        false_accepts: count(frames, |r| r.accepted && !r.success_refined),
+        false_rejects: count(frames, |r| !r.accepted && r.success_refined),
+        success_max_m2: s.iter().copied().fold(f64::NAN, f64::max),
+        success_median_m2: median(&s),
+        failure_min_m2: f.iter().copied().fold(f64::NAN, f64::min),
+        failure_median_m2: median(&f),
+    }
+}
+
+/// Success by range over 2.5-5, 5-10, 10-15 and 15-20 m (the last bin also
+/// holds the frames at 20 m or beyond).
+fn range_bins(frames: &[CnnFrame]) -> Vec<RangeBin> {
+    [2.5, 5.0, 10.0, 15.0, 20.0]
+        .windows(2)
+        .map(|w| range_bin(frames, w[0], w[1]))
+        .collect()
+}
+
+/// Success of the frames in [`lo`, `hi`) (unbounded above when `hi` ≥ 20 m).
+fn range_bin(frames: &[CnnFrame], lo: f64, hi: f64) -> RangeBin {
+    let bin: Vec<&CnnFrame> = frames
+        .iter()
+        .filter(|r| r.range_m >= lo && (r.range_m < hi || hi >= 20.0))
+        .collect();
+    let k = bin.len().max(1) as f64;
+    RangeBin {
+        range_m: [lo, hi],
+        frames: bin.len(),
+        success_rate_refined: bin.iter().filter(|r| r.success_refined).count() as f64 / k,
+        success_rate_raw: bin.iter().filter(|r| r.success_raw).count() as f64 / k,
+    }
+}
+
 /// Prints Tables III and IV.
 pub fn print(report: &CnnReport, frames: bool) {
-    println!(
-        "CNN pose estimation, {} held-out frames (seed {}), target {}, model {}, engine {} (one thread); \
-         mean {:.0} points per frame; {} estimator errors; {} frames refined several \
-         hypotheses, {} reported a hypothesis other than Γ_sym's (max {}); twin check: \
-         {} frames refined a twin, {} reported it",
-        report.count,
-        report.seed,
-        report.target,
-        report.model,
-        report.engine,
-        report.mean_points,
-        report.errors,
-        report.several_hypotheses,
-        report.other_hypothesis,
-        report.config.hypotheses,
-        report.twins_refined,
-        report.twin_used
-    );
-    let pct = |v: f64| num(100.0 * v, 1);
-    let ms = |m: MeanStd, d| format!("{} ± {}", num(m.mean, d), num(m.std, d));
-    let mut t3 = Table::new(&[
-        "step",
-        "success [%]",
-        "position error [cm]",
-        "angular error [deg]",
-    ]);
-    t3.row(vec![
-        "before refinement".into(),
-        pct(report.success_rate_raw),
-        ms(report.pos_err_cm.raw, 1),
-        ms(report.ang_err_deg.raw, 2),
-    ]);
-    t3.row(vec![
-        "after refinement".into(),
-        pct(report.success_rate_refined),
-        ms(report.pos_err_cm.refined, 1),
-        ms(report.ang_err_deg.refined, 2),
-    ]);
+    println!("{}", cnn_render::summary_line(report));
     println!(
         "\nTable III (success: < {SUCCESS_DEG}° with d_sym and < {SUCCESS_CM} cm; errors over the successes)"
     );
-    print!("{}", t3.render());
-    let mut t4 = Table::new(&["step", "median [ms]", "mean ± std [ms]", "p95 [ms]"]);
-    let t = &report.time_ms;
-    for (name, s) in [
-        ("preprocessing", t.preprocess),
-        ("CNN inference", t.inference),
-        ("NDT refinement", t.refinement),
-        ("total", t.total),
-    ] {
-        t4.row(vec![
-            name.into(),
-            num(s.median, 2),
-            format!("{} ± {}", num(s.mean, 2), num(s.std, 2)),
-            num(s.p95, 2),
-        ]);
-    }
+    print!("{}", cnn_render::table3(report).render());
     println!("\nTable IV (one thread)");
-    print!("{}", t4.render());
-    let f = &report.fconv;
-    println!(
-        "\nf_CONV check (f_MAX {:.2e} m²): accepted {}%, false accepts {}, false rejects {}; \
-         successes max {:.2e} median {:.2e} m², failures min {:.2e} median {:.2e} m²",
-        f.f_max_m2,
-        pct(f.accepted_rate),
-        f.false_accepts,
-        f.false_rejects,
-        f.success_max_m2,
-        f.success_median_m2,
-        f.failure_min_m2,
-        f.failure_median_m2
-    );
-    let mut bins = Table::new(&["range [m]", "frames", "raw [%]", "refined [%]"]);
-    for b in &report.by_range {
-        bins.row(vec![
-            format!("{}-{}", b.range_m[0], b.range_m[1]),
-            b.frames.to_string(),
-            pct(b.success_rate_raw),
-            pct(b.success_rate_refined),
-        ]);
-    }
-    print!("\n{}", bins.render());
+    print!("{}", cnn_render::table4(&report.time_ms).render());
+    println!("\n{}", cnn_render::fconv_line(&report.fconv));
+    print!("\n{}", cnn_render::range_table(&report.by_range).render());
     if frames {
-        let mut all = Table::new(&[
-            "frame", "range", "points", "raw deg", "raw cm", "deg", "cm", "f_conv", "expl", "twin",
-            "ok", "ms",
-        ]);
-        for r in &report.frames {
-            all.row(vec![
-                r.frame.to_string(),
-                num(r.range_m, 1),
-                r.points.to_string(),
-                num(r.raw_err_deg, 2),
-                num(r.raw_err_cm, 1),
-                num(r.err_deg, 2),
-                num(r.err_cm, 1),
-                format!("{:.1e}", r.f_conv_m2),
-                num(r.twins.explained, 3),
-                match (r.twins.twin, r.twins.twins_refined) {
-                    (Some(i), _) => format!("{i} used"),
-                    (None, 0) => "-".to_owned(),
-                    (None, n) => format!("{n} kept"),
-                },
-                r.success_refined.to_string(),
-                num(r.time_ms.total, 1),
-            ]);
-        }
-        print!("\n{}", all.render());
+        print!("\n{}", cnn_render::frames_table(&report.frames).render());
     }
 }
 

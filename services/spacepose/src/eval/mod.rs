@@ -3,8 +3,10 @@
 //! the tracker at the first frame (acquisition comes in a later issue).
 
 pub mod cnn;
+mod cnn_render;
 pub mod plot;
 pub mod stats;
 pub mod table;
 pub mod tm;
+mod tm_render;
 pub mod tracking;

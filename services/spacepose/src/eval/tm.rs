@@ -15,7 +15,7 @@
 //! threads; frames are simulated beforehand, in parallel.
 
 use super::stats::MeanMax;
-use super::table::{Table, num};
+use super::tm_render;
 use crate::cli::ScenarioArg;
 use crate::common::load_target;
 use crate::sim_cmd::progress_bar;
@@ -589,156 +589,14 @@ fn summarise(
     }
 }
 
-/// The report as text.
+/// The report as text: the header line, the summary table and, with
+/// `with_frames`, the per-frame table.
 pub fn render(report: &TmReport, with_frames: bool) -> String {
-    let c = &report.config;
-    let mut out = format!(
-        "template matching: {} / {}{} / seed {}{} / {} frames / Δ {}° {}/ {} / {}{} refined, mean {:.0} points\n",
-        report.target,
-        report.scenario,
-        if report.range_m.is_finite() {
-            format!(" at {} m", report.range_m)
-        } else {
-            String::new()
-        },
-        report.seed,
-        match report.sensor_effects {
-            SensorEffects::All => "",
-            SensorEffects::Seed002 => " / seed 002 sensor effects",
-        },
-        report.count,
-        c.delta_deg,
-        if c.fast {
-            format!("fast τ {} ", c.tau)
-        } else {
-            String::new()
-        },
-        if c.threads == Threads::Single {
-            "1 thread"
-        } else {
-            "all threads"
-        },
-        if c.screen_candidates > c.icp_candidates {
-            format!(
-                "≤ {} screened (budget {} points{}), ",
-                c.screen_candidates,
-                c.screen_point_budget,
-                if c.screen_rerank > 0 {
-                    format!(", best {} re-ranked by U", c.screen_rerank)
-                } else {
-                    String::new()
-                }
-            )
-        } else {
-            String::new()
-        },
-        c.icp_candidates,
-        report.mean_points,
-    );
-    let mut t = Table::new(&["figure", "value"]);
-    let pct = |v: f64| format!("{:.1} %", 100.0 * v);
-    t.row(vec![
-        "success rate after ICP (< 3°)".into(),
-        pct(report.success_rate),
-    ]);
-    t.row(vec![
-        format!("accepted (f_CONV ≤ {} m², U ≤ {})", c.f_max_m2, c.u_max),
-        pct(report.accepted_rate),
-    ]);
-    t.row(vec![
-        "accepted and successful".into(),
-        pct(report.accepted_success_rate),
-    ]);
-    t.row(vec![
-        "false accepts / false rejects".into(),
-        format!("{} / {}", report.false_accepts, report.false_rejects),
-    ]);
-    let e = report.euler_err_deg;
-    t.row(vec![
-        "TM Euler error yaw/pitch/roll (deg, successes)".into(),
-        format!("{} / {} / {}", num(e[0], 1), num(e[1], 1), num(e[2], 1)),
-    ]);
-    t.row(vec![
-        "attitude error after ICP (deg, successes)".into(),
-        num(report.err_deg_success_mean, 2),
-    ]);
-    t.row(vec![
-        "templates generated / evaluated (grid)".into(),
-        format!(
-            "{:.0} / {:.0} ({})",
-            report.templates.generated, report.templates.evaluated, report.templates.grid
-        ),
-    ]);
-    t.row(vec![
-        "time per acquisition mean / max (ms)".into(),
-        format!(
-            "{} / {}",
-            num(report.time_ms.mean, 1),
-            num(report.time_ms.max, 1)
-        ),
-    ]);
-    t.row(vec![
-        "  of which matching / ICP mean (ms)".into(),
-        format!(
-            "{} / {}",
-            num(report.matching_ms.mean, 1),
-            num(report.refinement_ms.mean, 1)
-        ),
-    ]);
-    t.row(vec![
-        "f_CONV success max / mean (m²)".into(),
-        format!(
-            "{} / {}",
-            sci(report.fconv_success_max),
-            sci(report.fconv_success_mean)
-        ),
-    ]);
-    t.row(vec![
-        "f_CONV failure min / mean (m²)".into(),
-        format!(
-            "{} / {}",
-            sci(report.fconv_failure_min),
-            sci(report.fconv_failure_mean)
-        ),
-    ]);
-    t.row(vec![
-        "f_CONV separates success from failure".into(),
-        report.separable.to_string(),
-    ]);
-    t.row(vec![
-        "unexplained U success max / failure min (f_CONV ok)".into(),
-        format!(
-            "{} / {}",
-            num(report.unexplained_success_max, 3),
-            num(report.unexplained_failure_min, 3)
-        ),
-    ]);
-    out.push_str(&t.render());
+    let mut out = tm_render::header(report);
+    out.push_str(&tm_render::summary_table(report).render());
     if with_frames {
-        let mut f = Table::new(&[
-            "frame",
-            "range m",
-            "points",
-            "err deg",
-            "TM err deg",
-            "f_CONV m²",
-            "ms",
-            "note",
-        ]);
-        for r in &report.frames {
-            f.row(vec![
-                r.frame.to_string(),
-                num(r.range_m, 1),
-                r.points.to_string(),
-                num(r.err_deg, 2),
-                num(r.coarse_err_deg, 1),
-                sci(r.f_conv_m2),
-                num(r.time_ms, 0),
-                r.error.clone().unwrap_or_default(),
-            ]);
-        }
         out.push('\n');
-        out.push_str(&f.render());
+        out.push_str(&tm_render::frames_table(&report.frames).render());
     }
     out
 }
