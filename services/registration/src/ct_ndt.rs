@@ -3,10 +3,11 @@
 //! the pose interpolated at its timestamp (Eq. 13-14), with the Jacobian of
 //! Eq. (15) (Appendix A.2).
 
+use crate::degeneracy::constrained_directions;
 use crate::error::RegistrationError;
 use crate::gauss_newton;
 use crate::ndt_map::NdtMap;
-use crate::normal_equations::{Constrained, NormalEquations};
+use crate::normal_equations::NormalEquations;
 use crate::params::NdtParams;
 use crate::result::Registration;
 use crate::source::{check_pose, position_is_finite};
@@ -361,30 +362,6 @@ pub fn register_ct_ndt(
         constrained.as_ref(),
         |end, stride| linearise(map, &points, t_target_sensor_start, end, stride, params),
     )
-}
-
-/// Degeneracy handling (`NdtParams::min_lever_arm_m`) on the end pose:
-/// its directions come from the rigid geometric information of the cloud
-/// placed at the initial end pose (Eq. 15 scales each point's Jacobian by
-/// its interpolation factor, which weighs the points but does not change
-/// which rotations the surface leaves free). `None` when disabled.
-fn constrained_directions(
-    map: &NdtMap,
-    source: &[Point],
-    initial_t_target_sensor_end: &Pose,
-    params: &NdtParams,
-) -> Option<Constrained> {
-    if params.min_lever_arm_m <= 0.0 {
-        return None;
-    }
-    let positions: Vec<Vector3<f64>> = source
-        .iter()
-        .filter(|p| position_is_finite(p) && p.t.is_finite())
-        .map(Point::position)
-        .collect();
-    let (h, n) =
-        crate::ndt::geometric_information(map, &positions, initial_t_target_sensor_end, 1, params);
-    Constrained::of(&h, n, params.min_lever_arm_m)
 }
 
 #[cfg(test)]

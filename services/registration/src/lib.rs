@@ -14,6 +14,7 @@
 #![forbid(unsafe_code)]
 
 pub mod ct_ndt;
+pub mod degeneracy;
 pub mod error;
 mod gauss_newton;
 pub mod icp;
@@ -35,6 +36,7 @@ pub use ct_ndt::{
     ct_point_jacobian, interpolate, register_ct_ndt, register_ct_ndt_free_start,
     register_ct_ndt_with_priors,
 };
+pub use degeneracy::hold_weak_rotations;
 pub use error::RegistrationError;
 pub use icp::{IcpFarLookupStats, IcpLookupStats, IcpModel, register_icp};
 pub use ndt::register_ndt;

@@ -100,4 +100,4 @@ mod tests;
 
 #[cfg(test)]
 #[path = "ndt/degeneracy_tests.rs"]
-mod degeneracy_tests;
+pub(crate) mod degeneracy_tests;

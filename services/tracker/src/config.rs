@@ -103,6 +103,14 @@ pub struct TrackerConfig {
     /// and 5 cm, diverged at 5.5 cm, the held rotation's own
     /// `min_lever_arm_m`, at frame 1046); 5 cm.
     pub ndt_mode_min_lever_arm_m: f64,
+    /// `ndt.min_lever_arm_m` in `icp` mode (m): ICP's Hessian is that of
+    /// the points, so the rotations the surface leaves free are found from
+    /// the NDT map's normals ([`spacepose_registration::hold_weak_rotations`])
+    /// and held at the filter's prediction (then moved onto the fitted
+    /// rate, as in the other modes). From the previous pose, nearest
+    /// neighbours drag the roll from a lever arm of about 5.4 cm (slow-spin,
+    /// approaching the 3 m hold). See [`DEFAULT_ICP_MODE_MIN_LEVER_ARM_M`].
+    pub icp_mode_min_lever_arm_m: f64,
     /// The rate a held rotation follows (see [`crate::held_rotation`]):
     /// fitted over the track before the hold instead of the filter's.
     pub held_rotation: HeldRotationConfig,
@@ -206,6 +214,13 @@ pub const DEFAULT_CT_NDT_ATTITUDE_COVARIANCE_SCALE: f64 = 1.0;
 /// Default [`TrackerConfig::ndt_mode_min_lever_arm_m`] (m).
 pub const DEFAULT_NDT_MODE_MIN_LEVER_ARM_M: f64 = 0.05;
 
+/// Default [`TrackerConfig::icp_mode_min_lever_arm_m`] (m). Tuned on
+/// slow-spin seed 1 (`icp` max: 8.64° at 5 cm, 4.74° at 5.5, 2.88° at 6;
+/// at 6.5 cm the roll is held from the first frame, where the 15 m views'
+/// lever arm is 5.5-6.2 cm, the filter never learns the spin, and the track
+/// is lost): 5.5 cm keeps a centimetre from that cliff.
+pub const DEFAULT_ICP_MODE_MIN_LEVER_ARM_M: f64 = 0.055;
+
 /// Default `ndt.min_lever_arm_m` of the tracker (m); see
 /// [`TrackerConfig::ndt`].
 pub const DEFAULT_MIN_LEVER_ARM_M: f64 = 0.035;
@@ -221,6 +236,7 @@ impl Default for TrackerConfig {
             },
             release_lever_arm_m: DEFAULT_RELEASE_LEVER_ARM_M,
             ndt_mode_min_lever_arm_m: DEFAULT_NDT_MODE_MIN_LEVER_ARM_M,
+            icp_mode_min_lever_arm_m: DEFAULT_ICP_MODE_MIN_LEVER_ARM_M,
             held_rotation: HeldRotationConfig::default(),
             icp: IcpParams::default(),
             geometric_sigma_m: 0.0,
@@ -250,10 +266,12 @@ impl TrackerConfig {
 
     /// The degeneracy handling's threshold in the current mode:
     /// [`TrackerConfig::ndt_mode_min_lever_arm_m`] in `ndt` mode,
+    /// [`TrackerConfig::icp_mode_min_lever_arm_m`] in `icp` mode,
     /// `ndt.min_lever_arm_m` otherwise.
     pub fn min_lever_arm_m(&self) -> f64 {
         match self.mode {
             TrackingMode::Ndt => self.ndt_mode_min_lever_arm_m,
+            TrackingMode::Icp => self.icp_mode_min_lever_arm_m,
             _ => self.ndt.min_lever_arm_m,
         }
     }
@@ -281,6 +299,10 @@ impl TrackerConfig {
         let n = self.ndt_mode_min_lever_arm_m;
         if !(n.is_finite() && n >= 0.0) {
             return Err(bad("ndt_mode_min_lever_arm_m must be finite and >= 0", n));
+        }
+        let n = self.icp_mode_min_lever_arm_m;
+        if !(n.is_finite() && n >= 0.0) {
+            return Err(bad("icp_mode_min_lever_arm_m must be finite and >= 0", n));
         }
         if !(self.release_lever_arm_m.is_finite() && self.release_lever_arm_m >= 0.0) {
             return Err(bad(
@@ -364,14 +386,21 @@ mod tests {
                 ..TrackerConfig::default()
             };
             assert!(c.validate().is_err(), "{v}");
+            let c = TrackerConfig {
+                icp_mode_min_lever_arm_m: v,
+                ..TrackerConfig::default()
+            };
+            assert!(c.validate().is_err(), "{v}");
         }
     }
 
     #[test]
-    fn ndt_mode_has_its_own_hold_threshold() {
+    fn ndt_and_icp_modes_have_their_own_hold_thresholds() {
         let ndt = TrackerConfig::with_mode(TrackingMode::Ndt);
         assert_eq!(ndt.min_lever_arm_m(), DEFAULT_NDT_MODE_MIN_LEVER_ARM_M);
-        for mode in [TrackingMode::Deblur, TrackingMode::CtNdt, TrackingMode::Icp] {
+        let icp = TrackerConfig::with_mode(TrackingMode::Icp);
+        assert_eq!(icp.min_lever_arm_m(), DEFAULT_ICP_MODE_MIN_LEVER_ARM_M);
+        for mode in [TrackingMode::Deblur, TrackingMode::CtNdt] {
             let c = TrackerConfig::with_mode(mode);
             assert_eq!(c.min_lever_arm_m(), DEFAULT_MIN_LEVER_ARM_M);
         }

@@ -13,7 +13,7 @@ use spacepose_filter::{MotionCompensation, Prediction, RelativeMotionFilter};
 use spacepose_geometry::{Point, Pose, VoxelFilter, so3};
 use spacepose_registration::{
     CtPriors, DisplacementPrior, NdtParams, RatePrior, Registration, ScanTimes, StartPrior,
-    register_ct_ndt, register_ct_ndt_with_priors, register_icp, register_ndt,
+    hold_weak_rotations, register_ct_ndt, register_ct_ndt_with_priors, register_icp, register_ndt,
 };
 use std::time::Instant;
 
@@ -369,7 +369,16 @@ impl Tracker {
         };
         Ok(match c.mode {
             TrackingMode::Ndt => register_ndt(map, cloud, &previous, ndt)?,
-            TrackingMode::Icp => register_icp(self.model.icp()?, cloud, &previous, &c.icp)?,
+            // ICP holds a rotation the surface leaves free without saying
+            // so. It is held at the prediction instead, as `deblur` holds
+            // it, and reported as NDT reports it, so that the hold follows
+            // the fitted rate (`follow_held_rate`) when there is one. At
+            // the previous pose it stood still without a fit (slow-spin
+            // seed 7: from frame 1320 at 4.5 m, 1°/s, lost).
+            TrackingMode::Icp => {
+                let r = register_icp(self.model.icp()?, cloud, &previous, &c.icp)?;
+                hold_weak_rotations(map, cloud, &predicted, r, ndt)
+            }
             TrackingMode::Deblur => register_ndt(map, cloud, &predicted, ndt)?,
             // A sparse frame, compensated by the prediction: one pose.
             TrackingMode::CtNdt if compensated => register_ndt(map, cloud, &predicted, ndt)?,

@@ -17,10 +17,11 @@
 //! The reported information is that of `T^e` with `T^s` marginalised out
 //! (Schur complement), the reported cost that of the points alone.
 
+use super::ScanTimes;
 use super::displacement_prior::DisplacementPrior;
 use super::joint::{Joint, TimedPoint, linearise, split};
 use super::rate_prior::RatePrior;
-use super::{ScanTimes, constrained_directions};
+use crate::degeneracy::constrained_directions;
 use crate::error::RegistrationError;
 use crate::ndt_map::NdtMap;
 use crate::normal_equations::{Constrained, increment_of};

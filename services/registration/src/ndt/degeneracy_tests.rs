@@ -9,7 +9,7 @@ use nalgebra::{Rotation3, Vector6};
 
 /// A disc of radius 0.7 m in the plane x = 0 and a cylinder of radius
 /// 0.12 m along +x up to 0.45 m, sampled every `s` metres (body frame).
-fn plane_and_cylinder(s: f64) -> Vec<Vector3<f64>> {
+pub(crate) fn plane_and_cylinder(s: f64) -> Vec<Vector3<f64>> {
     let mut pts = Vec::new();
     let n = (0.7 / s) as i32;
     for i in -n..=n {
@@ -35,19 +35,19 @@ fn plane_and_cylinder(s: f64) -> Vec<Vector3<f64>> {
 }
 
 /// The sensor 2 m in front of the plane, looking along −x of the body.
-fn truth() -> Pose {
+pub(crate) fn truth() -> Pose {
     let look = Rotation3::from_axis_angle(&Vector3::y_axis(), std::f64::consts::FRAC_PI_2);
     Pose::new(look, Vector3::new(0.0, 0.0, 2.0))
 }
 
-fn cloud(model: &[Vector3<f64>], t_sensor_target: &Pose) -> Vec<Point> {
+pub(crate) fn cloud(model: &[Vector3<f64>], t_sensor_target: &Pose) -> Vec<Point> {
     model
         .iter()
         .map(|p| Point::from_vector(&t_sensor_target.transform(p), 1.0, 0.0))
         .collect()
 }
 
-fn map(model: &[Vector3<f64>]) -> NdtMap {
+pub(crate) fn map(model: &[Vector3<f64>]) -> NdtMap {
     NdtMap::build(model, &NdtMapParams::default()).unwrap()
 }
 
