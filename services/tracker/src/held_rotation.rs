@@ -222,14 +222,7 @@ impl HeldRotation {
         }
         let phi = line.phi_last + turned(&line.last.r_ts, &t_target_sensor.rotation, &line.axis);
         let turn = line.phi_ref + line.rate * (t - line.t_ref) - phi;
-        let h_tt = information.fixed_view::<3, 3>(3, 3).into_owned();
-        let h_tr: Matrix3<f64> = information.fixed_view::<3, 3>(3, 0).into_owned();
-        let shift = h_tt
-            .try_inverse()
-            .map_or(Vector3::zeros(), |inv| -(inv * h_tr * line.axis));
-        let r = line.axis * turn;
-        let s = shift * turn;
-        *t_target_sensor = t_target_sensor.oplus(&Vector6::new(r.x, r.y, r.z, s.x, s.y, s.z));
+        *t_target_sensor = turn_about(t_target_sensor, &line.axis, turn, information);
         Some(HeldCorrection {
             rate_rad_s: line.rate,
             turn_rad: turn,
@@ -276,6 +269,25 @@ impl HeldRotation {
 /// `to` (rotations of `t_target_sensor`): `Log(R_to R_fromᵀ) · axis`.
 fn turned(from: &Rotation3<f64>, to: &Rotation3<f64>, axis: &Vector3<f64>) -> f64 {
     so3::log(&(to * from.inverse())).dot(axis)
+}
+
+/// `t_target_sensor` turned by `turn` (rad) about `axis` (unit, target
+/// frame), with the translation that keeps the surface fitted: per unit
+/// turn `−H_tt⁻¹ H_tr axis`, from the geometric `information`
+/// (`δ = [rot; trans]`, its Schur complement).
+pub fn turn_about(
+    t_target_sensor: &Pose,
+    axis: &Vector3<f64>,
+    turn: f64,
+    information: &nalgebra::Matrix6<f64>,
+) -> Pose {
+    let h_tt = information.fixed_view::<3, 3>(3, 3).into_owned();
+    let h_tr: Matrix3<f64> = information.fixed_view::<3, 3>(3, 0).into_owned();
+    let shift = h_tt
+        .try_inverse()
+        .map_or(Vector3::zeros(), |inv| -(inv * h_tr * axis));
+    let (r, s) = (axis * turn, shift * turn);
+    t_target_sensor.oplus(&Vector6::new(r.x, r.y, r.z, s.x, s.y, s.z))
 }
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 
 use crate::config::{CtStart, TrackerConfig};
 use crate::error::TrackError;
-use crate::held_rotation::HeldRotation;
+use crate::held_rotation::{HeldRotation, turn_about};
 use crate::measurement::{covariance_sensor_target, inversion_jacobian, measurement_information};
 use crate::mode::TrackingMode;
 use crate::model::TrackingModel;
@@ -368,7 +368,10 @@ impl Tracker {
             &base
         };
         Ok(match c.mode {
-            TrackingMode::Ndt => register_ndt(map, cloud, &previous, ndt)?,
+            // A held rotation is moved from the guess (the previous pose)
+            // to the prediction, as in `icp` mode: where no rate has been
+            // fitted it would otherwise stand still.
+            TrackingMode::Ndt => held_at(register_ndt(map, cloud, &previous, ndt)?, &predicted),
             // ICP holds a rotation the surface leaves free without saying
             // so. It is held at the prediction instead, as `deblur` holds
             // it, and reported as NDT reports it, so that the hold follows
@@ -682,6 +685,24 @@ fn weakest_rotation(h: &Matrix6<f64>) -> Option<Vector3<f64>> {
     v.iter().all(|x| x.is_finite()).then_some(v)
 }
 
+/// `registration` with its held rotation (one, as [`weakest_rotation`]
+/// finds it) turned to that of `reference`, with the translation that goes
+/// with the turn; unchanged when it held none.
+fn held_at(mut registration: Registration, reference: &Pose) -> Registration {
+    if registration.degenerate_directions != 1 {
+        return registration;
+    }
+    let Some(h) = registration.geometric_information else {
+        return registration;
+    };
+    if let Some(axis) = weakest_rotation(&h) {
+        let eps = reference.ominus(&registration.t_target_sensor);
+        let turn = axis.dot(&eps.fixed_rows::<3>(0));
+        registration.t_target_sensor = turn_about(&registration.t_target_sensor, &axis, turn, &h);
+    }
+    registration
+}
+
 fn ms(since: Instant) -> f64 {
     since.elapsed().as_secs_f64() * 1e3
 }
@@ -702,8 +723,57 @@ fn check_scan_times(start_s: f64, end_s: f64, previous_end_s: f64) -> Result<(),
 
 #[cfg(test)]
 mod helper_tests {
-    use super::{attitude_scaling, weakest_rotation};
-    use nalgebra::{Matrix6, Vector3};
+    use super::{attitude_scaling, held_at, weakest_rotation};
+    use nalgebra::{Matrix6, Vector3, Vector6};
+    use spacepose_geometry::Pose;
+    use spacepose_registration::{Cost, Increment, Registration};
+
+    /// A result at the identity that held `held` rotations, with geometric
+    /// information `h`.
+    fn held_result(held: usize, h: Matrix6<f64>) -> Registration {
+        Registration {
+            t_target_sensor: Pose::identity(),
+            converged: true,
+            iterations: 3,
+            cost: Cost {
+                total: 1.0,
+                mean: 0.01,
+            },
+            inliers: 100,
+            valid_points: 100,
+            skipped_non_finite: 0,
+            mean_squared_distance_m2: 1e-4,
+            f_conv_m2: None,
+            information: Matrix6::identity() * 7.0,
+            last_increment: Increment::default(),
+            degenerate_directions: held,
+            weakest_lever_arm_m: 0.01,
+            geometric_information: Some(h),
+        }
+    }
+
+    /// The held rotation (about x here) takes the reference's angle; the
+    /// measured ones stay the registration's.
+    #[test]
+    fn a_held_rotation_is_turned_to_the_reference() {
+        let mut h = Matrix6::identity() * 100.0;
+        h[(0, 0)] = 1e-4;
+        let reference = Pose::identity().oplus(&Vector6::new(
+            3f64.to_radians(),
+            1f64.to_radians(),
+            0.0,
+            0.0,
+            0.0,
+            0.02,
+        ));
+        let moved = held_at(held_result(1, h), &reference);
+        let eps = moved.t_target_sensor.ominus(&Pose::identity());
+        assert!((eps[0].to_degrees() - 3.0).abs() < 1e-6, "{eps:?}");
+        assert!(eps[1].abs() < 1e-9 && eps[5].abs() < 1e-9, "{eps:?}");
+        // Nothing held: unchanged.
+        let kept = held_at(held_result(0, h), &reference);
+        assert_eq!(kept.t_target_sensor, Pose::identity());
+    }
 
     /// The held axis is the rotation with the least information once the
     /// translation is marginalised out, even when the raw rotation block
