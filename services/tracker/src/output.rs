@@ -22,11 +22,13 @@ pub struct Timings {
 pub struct TrackOutput {
     /// Scan end time: the time the pose refers to (s).
     pub t: f64,
-    /// Estimated `t_sensor_target` at scan end. For a lost frame, the
-    /// filter prediction (flagged by `status`).
+    /// Estimated `t_sensor_target` at scan end. For a lost frame, and for a
+    /// degraded one in `deblur` and `ct-ndt` modes, the filter prediction
+    /// (flagged by `status`; the doubted measurement is in `registration`).
     pub t_sensor_target: Pose,
-    /// Covariance of `t_sensor_target` (left ⊕, `[rot; trans]`), from the
-    /// registration information; `None` when degenerate or lost.
+    /// Covariance of `t_sensor_target` (left ⊕, `[rot; trans]`): from the
+    /// registration information, or the prediction's where the pose is the
+    /// prediction; `None` when degenerate or lost.
     pub covariance: Option<Matrix6<f64>>,
     /// Track health after this frame.
     pub status: TrackStatus,

@@ -11,8 +11,10 @@ pub enum TrackStatus {
     /// filter prediction.
     Tracking,
     /// A pose was produced but its quality is doubtful (no convergence, few
-    /// inliers, high cost, or disagreement with the prediction). The pose is
-    /// published but not fused into the filter.
+    /// inliers, high cost, or disagreement with the prediction). It is not
+    /// fused into the filter; the published pose is the measurement in
+    /// `ndt` and `icp` modes and the filter prediction in `deblur` and
+    /// `ct-ndt` modes.
     Degraded,
     /// The registration failed, or too many degraded frames in a row: the
     /// track must be re-acquired ([`crate::Tracker::initialize`]).

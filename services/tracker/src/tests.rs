@@ -74,3 +74,34 @@ fn misuse_is_an_error() {
         Err(TrackError::InvalidScanTimes { .. })
     ));
 }
+
+#[test]
+fn a_doubted_frame_publishes_the_filter_estimate_where_it_seeds_the_registration() {
+    let (target, model) = fixture();
+    // The target turns 3° and moves 6 mm in a second, but the filter starts
+    // at rest: with a 1 mm innovation bound the measurement is doubted.
+    let frame = target.frame(&truth(1.0, 3.0), 0.02);
+    for mode in [TrackingMode::Ndt, TrackingMode::Deblur, TrackingMode::CtNdt] {
+        let mut config = TrackerConfig::with_mode(mode);
+        config.loss.max_innovation_pos_m = 1e-3;
+        let mut tracker = Tracker::new(config, model.clone()).unwrap();
+        let start = truth(0.0, 3.0);
+        tracker
+            .initialize(0.0, &start, Vector3::zeros(), Vector3::zeros())
+            .unwrap();
+        let out = tracker.process(&frame, 0.0, 1.0).unwrap();
+        assert_eq!(out.status, TrackStatus::Degraded, "{mode}: {}", out.reason);
+        assert!(out.reason.contains("inconsistent with prediction"));
+        let measured = out.registration.as_ref().unwrap().t_sensor_target();
+        let (turned, _) = measured.error_to(&start);
+        assert!(turned.to_degrees() > 2.0, "{mode}: {}", turned.to_degrees());
+        let expected = if mode.uses_prediction() {
+            start
+        } else {
+            measured
+        };
+        let (angle, dist) = out.t_sensor_target.error_to(&expected);
+        assert!(angle < 1e-9 && dist < 1e-9, "{mode}: {angle} rad, {dist} m");
+        assert!(out.covariance.is_some());
+    }
+}
