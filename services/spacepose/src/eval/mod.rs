@@ -10,3 +10,4 @@ pub mod table;
 pub mod tm;
 mod tm_render;
 pub mod tracking;
+mod tracking_render;

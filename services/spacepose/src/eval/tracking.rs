@@ -20,7 +20,7 @@
 
 use super::plot::{Series, plot_errors};
 use super::stats::{MeanMax, median};
-use super::table::{Table, num};
+use super::tracking_render;
 use crate::cli::{EvalTrackingArgs, ModeArg, ScenarioArg};
 use crate::common::load_target;
 use crate::sim_cmd::progress_bar;
@@ -406,106 +406,6 @@ fn summarise(series: Vec<FrameRecord>, warmup: usize) -> ModeReport {
     }
 }
 
-/// The paper's figures for the same scenario (seed 000 Tables 2-3):
-/// (mode, ang mean, ang max, pos mean, pos max, time mean, time max, it mean, it max).
-fn paper_rows(scenario: &str) -> &'static [(&'static str, [f64; 8])] {
-    match scenario {
-        "slow-spin" => &[
-            ("ndt", [1.39, 2.59, 4.10, 10.21, 35.4, 94.0, 9.9, 20.0]),
-            ("deblur", [1.00, 2.00, 4.00, 9.86, 22.2, 62.0, 4.3, 20.0]),
-            ("ct-ndt", [1.01, 2.09, 4.01, 8.32, 41.8, 127.0, 6.9, 20.0]),
-            ("icp", [1.91, 4.65, 4.85, 9.94, 174.4, 432.0, 32.7, 40.0]),
-        ],
-        "tumbling" => &[
-            ("deblur", [1.27, 8.26, 3.26, 6.25, 26.4, 81.0, 5.4, 20.0]),
-            ("ct-ndt", [1.37, 3.11, 3.56, 7.36, 47.0, 137.0, 7.1, 20.0]),
-        ],
-        _ => &[],
-    }
-}
-
-/// The report as the table of seed 000 Tables 2-3, with the paper's rows.
-pub fn render(report: &TrackingReport) -> String {
-    let mut t = Table::new(&[
-        "mode",
-        "ang mean",
-        "ang max",
-        "ang max*",
-        "pos mean",
-        "pos max",
-        "ms mean",
-        "ms median",
-        "ms max",
-        "it mean",
-        "it max",
-        "lost",
-        "diverged",
-    ]);
-    for (name, m) in &report.modes {
-        t.row(vec![
-            name.clone(),
-            num(m.ang_err_deg.mean, 2),
-            num(m.ang_err_deg.max, 2),
-            num(m.ang_err_deg_converged.max, 2),
-            num(m.pos_err_cm.mean, 2),
-            num(m.pos_err_cm.max, 2),
-            num(m.time_ms.mean, 2),
-            num(m.time_ms_median, 2),
-            num(m.time_ms.max, 2),
-            num(m.iterations.mean, 1),
-            num(m.iterations.max, 0),
-            m.lost_frames.to_string(),
-            m.diverged_frames.to_string(),
-        ]);
-    }
-    for (name, v) in paper_rows(&report.scenario) {
-        t.row(vec![
-            format!("paper {name}"),
-            num(v[0], 2),
-            num(v[1], 2),
-            "-".into(),
-            num(v[2], 2),
-            num(v[3], 2),
-            num(v[4], 1),
-            "-".into(),
-            num(v[5], 0),
-            num(v[6], 1),
-            num(v[7], 0),
-            "0".into(),
-            "-".into(),
-        ]);
-    }
-    let fallbacks: String = report
-        .modes
-        .iter()
-        .filter(|(_, m)| m.fallback_frames > 0)
-        .map(|(name, m)| {
-            format!(
-                "{name}: {} frames fitted as deblur after CT-NDT stalled\n",
-                m.fallback_frames
-            )
-        })
-        .collect();
-    format!(
-        "{} with {}: {} frames from frame {} (seed {}, compression {}), {:.0} raw points per frame on average\n\
-         errors in deg and cm; time in ms per frame, one thread, voxel filter included;\n\
-         ang max* = max after {} warm-up frames; diverged = true error > {DIVERGED_DEG}° or {} cm\n\
-         scan blur: the truth turns {:.2}° on average ({:.2}° max) between a frame's mean return time and its end\n{}",
-        report.scenario,
-        report.target,
-        report.frames,
-        report.first_frame,
-        report.seed,
-        report.compression,
-        report.mean_points_in,
-        report.warmup,
-        DIVERGED_M * 100.0,
-        report.blur_lag_deg.mean,
-        report.blur_lag_deg.max,
-        t.render()
-    ) + &fallbacks
-}
-
 /// Runs the command.
 pub fn run(args: &EvalTrackingArgs) -> Result<()> {
     let modes = match args.mode {
@@ -534,7 +434,7 @@ pub fn run(args: &EvalTrackingArgs) -> Result<()> {
             .transpose()?,
     };
     let report = evaluate(&config)?;
-    print!("{}", render(&report));
+    print!("{}", tracking_render::render(&report));
     if let Some(path) = &args.json {
         write_json(path, &report)?;
     }
