@@ -21,6 +21,7 @@ pub mod clutter;
 pub mod config;
 pub mod detection;
 pub mod error;
+mod measurement;
 pub mod optics;
 pub mod pattern;
 mod scene;

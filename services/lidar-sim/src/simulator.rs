@@ -5,17 +5,16 @@
 use crate::config::{SensorConfig, SurfaceModel};
 use crate::detection::DetectionModel;
 use crate::error::SimError;
-use crate::optics::tilt;
+use crate::measurement::Measurement;
+use crate::pattern::Scan;
 use crate::scene::{FrameScene, TargetMotion};
 use crate::surface::{Surface, draw_surfaces, validate_materials};
 use nalgebra::Vector3;
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rand_distr::StandardNormal;
 use spacepose_geometry::Point;
 use spacepose_scenario::TruthState;
 use spacepose_target::Target;
-use std::f64::consts::TAU;
 use std::sync::Arc;
 
 /// Reported intensity = received return factor (m⁻²) × this reference area:
@@ -144,21 +143,31 @@ impl LidarSimulator {
             return Err(SimError::NonFiniteTruth(truth.t));
         }
         let c = &self.config;
-        let fx = c.effects;
         // Per-frame draws: scan phase, then material properties (seed 004 §IV.B).
         let scan = c
             .pattern
             .scan(truth.t, c.integration_time_s, c.points_per_second, rng);
-        let scene = FrameScene {
+        let scene = self.frame_scene(truth, rng);
+        let (points, kinds) = self.measure_scan(&scan, &scene, rng);
+        Ok(Frame {
+            points,
+            kinds,
+            scan_start: scan.scan_start(),
+            scan_end: truth.t,
+            truth: *truth,
+        })
+    }
+
+    /// The scene of the frame ending at `truth.t`: the target moving with
+    /// `truth`'s velocities, this frame's surface draws (the only random
+    /// draws here), the facility background if `Effects::clutter`, and the
+    /// beam (divergence, reflections) as the effects ask.
+    fn frame_scene(&self, truth: &TruthState, rng: &mut ChaCha8Rng) -> FrameScene<'_> {
+        let c = &self.config;
+        let fx = c.effects;
+        FrameScene {
             target: &self.target,
-            motion: TargetMotion {
-                r_sensor_target: truth.t_sensor_target.rotation,
-                t_sensor_target: truth.t_sensor_target.translation,
-                v_sensor: truth.v_sensor_target,
-                w_target: truth.w_target,
-                t_end: truth.t,
-                blur: fx.motion_blur,
-            },
+            motion: scan_motion(truth, fx.motion_blur),
             surfaces: self.frame_surfaces(rng),
             clutter: if fx.clutter {
                 c.facility.build(&self.target, &truth.t_sensor_target)
@@ -180,58 +189,48 @@ impl LidarSimulator {
             reflections: fx.reflections,
             max_range: c.max_range_m,
             reflection_offset_m: 1e-4 * self.target.bounding_radius() + 1e-6,
-        };
-        let los_sigma = c.los_sigma_deg.to_radians();
+        }
+    }
+
+    /// Every ray of `scan` traced through `scene` and measured, in scan
+    /// order: the detected points and what produced each.
+    fn measure_scan(
+        &self,
+        scan: &Scan,
+        scene: &FrameScene<'_>,
+        rng: &mut ChaCha8Rng,
+    ) -> (Vec<Point>, Vec<ReturnKind>) {
+        let measurement = Measurement::new(&self.config, &self.detection);
         let mut points = Vec::with_capacity(scan.len() / 2);
         let mut kinds = Vec::with_capacity(scan.len() / 2);
         for (t, dir) in scan.rays() {
             let Some(echo) = scene.trace_beam(t, &dir, rng) else {
                 continue;
             };
-            if fx.detection {
-                // Eq. (4)-(9), then a uniform draw (seed 002 §3.2).
-                let p_d = self
-                    .detection
-                    .probability(self.detection.snr(echo.intensity));
-                if rng.random::<f64>() >= p_d {
-                    continue;
-                }
+            if let Some((point, kind)) = measurement.measure(t, &dir, &echo, rng) {
+                points.push(point);
+                kinds.push(kind);
             }
-            let mut kind = if echo.clutter {
-                ReturnKind::Clutter
-            } else {
-                ReturnKind::Target
-            };
-            let mut range = echo.depth;
-            if fx.outliers && rng.random_bool(c.outlier_probability) {
-                let n: f64 = rng.sample(StandardNormal);
-                range += n * c.outlier_sigma_factor * c.range_sigma_m;
-                kind = ReturnKind::Outlier;
-            } else if fx.range_noise {
-                let n: f64 = rng.sample(StandardNormal);
-                range += n * c.range_sigma_m;
-            }
-            let out_dir = if fx.los_noise {
-                // Normal angle about a uniform azimuth (seed 002 §3.2).
-                let n: f64 = rng.sample(StandardNormal);
-                tilt(&dir, n * los_sigma, rng.random_range(0.0..TAU))
-            } else {
-                dir
-            };
-            let intensity = (echo.intensity * INTENSITY_REFERENCE_M2) as f32;
-            points.push(Point::from_vector(&(out_dir * range), intensity, t));
-            kinds.push(kind);
         }
-        Ok(Frame {
-            points,
-            kinds,
-            scan_start: scan.scan_start(),
-            scan_end: truth.t,
-            truth: *truth,
-        })
+        (points, kinds)
     }
 }
 
+/// The target's motion during the scan ending at `truth.t`: `truth`'s pose
+/// extrapolated backwards with its constant velocity (seed 000 Eq. 8) and
+/// angular velocity (Eq. 9) when `blur`, else held at the scan-end pose.
+fn scan_motion(truth: &TruthState, blur: bool) -> TargetMotion {
+    TargetMotion {
+        r_sensor_target: truth.t_sensor_target.rotation,
+        t_sensor_target: truth.t_sensor_target.translation,
+        v_sensor: truth.v_sensor_target,
+        w_target: truth.w_target,
+        t_end: truth.t,
+        blur,
+    }
+}
+
+/// Whether every field of `truth` (time, pose, velocities) is finite.
 fn truth_is_finite(truth: &TruthState) -> bool {
     let finite = |v: &Vector3<f64>| v.iter().all(|x| x.is_finite());
     truth.t.is_finite()
