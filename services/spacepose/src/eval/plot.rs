@@ -21,6 +21,11 @@ pub struct Series<'a> {
     pub ang_err_deg: &'a [f64],
     /// Position error (cm); NaN where the frame had no estimate.
     pub pos_err_cm: &'a [f64],
+    /// The method lost the target in truth (errors of 180°): it does not
+    /// set the axis range when another method did not, and is drawn
+    /// clipped at the top, labelled so, as seed 000 Fig. 11 leaves out the
+    /// methods that failed.
+    pub diverged: bool,
 }
 
 const COLORS: [RGBColor; 6] = [
@@ -105,12 +110,7 @@ where
         .iter()
         .flat_map(|s| s.t.iter().copied())
         .fold(t_max, f64::min);
-    let y_max = series
-        .iter()
-        .flat_map(|s| pick(s).iter().copied().filter(|v| v.is_finite()))
-        .fold(0.0_f64, f64::max)
-        .max(1e-3)
-        * 1.1;
+    let y_max = y_range(series, &pick);
     let mut chart = ChartBuilder::on(area)
         .margin(12)
         .x_label_area_size(40)
@@ -130,12 +130,18 @@ where
             s.t.iter()
                 .zip(pick(s))
                 .filter(|(_, v)| v.is_finite())
-                .map(|(t, v)| (*t, *v))
+                .map(|(t, v)| (*t, v.min(y_max)))
                 .collect();
+        let clipped = pick(s).iter().any(|v| *v > y_max);
+        let label = if clipped {
+            format!("{} (clipped)", s.label)
+        } else {
+            s.label.to_string()
+        };
         chart
             .draw_series(LineSeries::new(points, color.stroke_width(1)))
             .map_err(|e| anyhow::anyhow!("{e:?}"))?
-            .label(s.label)
+            .label(label)
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
     }
     chart
@@ -146,6 +152,19 @@ where
         .draw()
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
     Ok(())
+}
+
+/// Top of the y axis: 10% above the largest finite value of the series
+/// that did not diverge (of all of them when every one did).
+fn y_range(series: &[Series<'_>], pick: &impl for<'s> Fn(&'s Series<'_>) -> &'s [f64]) -> f64 {
+    let all_diverged = series.iter().all(|s| s.diverged);
+    series
+        .iter()
+        .filter(|s| all_diverged || !s.diverged)
+        .flat_map(|s| pick(s).iter().copied().filter(|v| v.is_finite()))
+        .fold(0.0_f64, f64::max)
+        .max(1e-3)
+        * 1.1
 }
 
 #[cfg(test)]
@@ -163,6 +182,7 @@ mod tests {
             t: &t,
             ang_err_deg: &a,
             pos_err_cm: &p,
+            diverged: false,
         }];
         let png = dir.path().join("e.png");
         plot_errors(&png, "test", &s).unwrap();
@@ -171,5 +191,28 @@ mod tests {
         plot_errors(&svg, "test", &s).unwrap();
         assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
         assert!(plot_errors(&dir.path().join("e.jpg"), "t", &s).is_err());
+    }
+
+    fn angular<'s>(s: &'s Series<'_>) -> &'s [f64] {
+        s.ang_err_deg
+    }
+
+    #[test]
+    fn a_diverged_method_does_not_set_the_scale_unless_all_did() {
+        let t = [0.0, 1.0, 2.0];
+        let (good, bad) = ([0.5, 1.0, 2.0], [3.0, 90.0, 180.0]);
+        let series = |a, diverged| Series {
+            label: "m",
+            t: &t,
+            ang_err_deg: a,
+            pos_err_cm: a,
+            diverged,
+        };
+        let both = [series(&good, false), series(&bad, true)];
+        assert!((y_range(&both, &angular) - 2.2).abs() < 1e-12);
+        let failed = [series(&bad, true)];
+        assert!((y_range(&failed, &angular) - 198.0).abs() < 1e-9);
+        let dir = tempfile::tempdir().unwrap();
+        plot_errors(&dir.path().join("c.png"), "clipped", &both).unwrap();
     }
 }

@@ -439,7 +439,7 @@ pub fn run(args: &EvalTrackingArgs) -> Result<()> {
         write_json(path, &report)?;
     }
     if let Some(path) = &args.plot {
-        type Columns = (String, Vec<f64>, Vec<f64>, Vec<f64>);
+        type Columns = (String, Vec<f64>, Vec<f64>, Vec<f64>, bool);
         let series: Vec<Columns> = report
             .modes
             .iter()
@@ -447,16 +447,17 @@ pub fn run(args: &EvalTrackingArgs) -> Result<()> {
                 let t = m.series.iter().map(|r| r.t).collect();
                 let a = m.series.iter().map(|r| r.ang_err_deg).collect();
                 let p = m.series.iter().map(|r| r.pos_err_cm).collect();
-                (name.clone(), t, a, p)
+                (name.clone(), t, a, p, m.diverged_frames > 0)
             })
             .collect();
         let refs: Vec<Series<'_>> = series
             .iter()
-            .map(|(l, t, a, p)| Series {
+            .map(|(l, t, a, p, diverged)| Series {
                 label: l,
                 t,
                 ang_err_deg: a,
                 pos_err_cm: p,
+                diverged: *diverged,
             })
             .collect();
         let title = format!(
