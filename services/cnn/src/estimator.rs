@@ -25,7 +25,7 @@ use crate::classes::{ClassTable, DEFAULT_ROLL_STEP_DEG};
 use crate::decode::{DEFAULT_DELTA_BETA_DEG, decode, decode_around, modes};
 use crate::error::CnnError;
 use crate::model_meta::{ModelMeta, model_onnx_path};
-use crate::preprocess::{PreprocessConfig, preprocess};
+use crate::preprocess::{DepthImage, PreprocessConfig, preprocess};
 use crate::refinement::{Refined, RefinementConfig, Refiner, ms};
 use crate::twins::{TwinCheckConfig, TwinOutcome, check_twins};
 
@@ -119,6 +119,20 @@ pub struct CnnEstimate {
     pub time_ms: Timings,
     /// Of the refinement: the f_CONV ICP (ms).
     pub fconv_ms: f64,
+}
+
+/// The network's pose of one frame (§III.B, §III.D), decoded.
+struct NetworkPose {
+    /// Γ_sym's attitude (Algorithm 1) at the ROI centre plus the offset.
+    raw: Pose,
+    /// The network's class probabilities.
+    probs: Vec<f32>,
+    /// Δβ of Algorithm 1 (rad).
+    delta_beta: f64,
+    /// Class of largest probability.
+    top_class: usize,
+    /// Its probability.
+    top_probability: f32,
 }
 
 /// The refinement of the attitude hypotheses of one frame.
@@ -232,6 +246,40 @@ impl CnnEstimator {
     /// all-NaN cloud included); preprocessing or network errors.
     pub fn estimate(&self, cloud: &[Point]) -> Result<CnnEstimate, CnnError> {
         let start = Instant::now();
+        let finite = self.finite_points(cloud)?;
+        let image = preprocess(&finite, &self.preprocess)?;
+        let preprocess_ms = ms(start);
+
+        let t = Instant::now();
+        let net = self.network_pose(&image)?;
+        let inference_ms = ms(t);
+
+        let t = Instant::now();
+        let (refined, twins) = self.refine_and_check_twins(&finite, &net);
+        let refinement_ms = ms(t);
+        let time_ms = Timings {
+            preprocess: preprocess_ms,
+            inference: inference_ms,
+            refinement: refinement_ms,
+            total: ms(start),
+        };
+        let mut estimate = unrefined_estimate(
+            &net,
+            finite.len(),
+            image.points_in_roi,
+            refined.tried,
+            twins,
+            time_ms,
+        );
+        self.report_refinement(&mut estimate, refined);
+        Ok(estimate)
+    }
+
+    /// The finite points of `cloud`.
+    ///
+    /// # Errors
+    /// [`CnnError::TooFewPoints`] below `min_points` of them.
+    fn finite_points(&self, cloud: &[Point]) -> Result<Vec<Point>, CnnError> {
         let finite: Vec<Point> = cloud.iter().copied().filter(Point::is_finite).collect();
         if finite.len() < self.config.min_points {
             return Err(CnnError::TooFewPoints {
@@ -240,10 +288,15 @@ impl CnnEstimator {
                 required: self.config.min_points,
             });
         }
-        let image = preprocess(&finite, &self.preprocess)?;
-        let preprocess_ms = ms(start);
+        Ok(finite)
+    }
 
-        let t = Instant::now();
+    /// Runs the network on `image` (§III.D) and decodes its pose: Γ_sym's
+    /// attitude (Algorithm 1) at the ROI centre plus the offset (§III.B).
+    ///
+    /// # Errors
+    /// Network and decoding errors.
+    fn network_pose(&self, image: &DepthImage) -> Result<NetworkPose, CnnError> {
         let out = self
             .net
             .lock()
@@ -257,47 +310,37 @@ impl CnnEstimator {
             rotation,
             translation: image.roi_centre + offset,
         };
-        let (top_class, top_probability) = out
-            .probs
-            .iter()
-            .copied()
-            .enumerate()
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-            .unwrap_or((0, 0.0));
-        let inference_ms = ms(t);
+        let (top_class, top_probability) = top_class(&out.probs);
+        Ok(NetworkPose {
+            raw,
+            probs: out.probs,
+            delta_beta,
+            top_class,
+            top_probability,
+        })
+    }
 
-        let t = Instant::now();
-        let mut refined = self.refine_hypotheses(&finite, &raw, &out.probs, delta_beta);
+    /// Refines the attitude hypotheses of `net` on `cloud` (§III.E, with
+    /// the f_CONV check), then runs the twin check on the best refinement
+    /// (which it may replace); the default outcome when none succeeded.
+    fn refine_and_check_twins(
+        &self,
+        cloud: &[Point],
+        net: &NetworkPose,
+    ) -> (Hypotheses, TwinOutcome) {
+        let mut refined = self.refine_hypotheses(cloud, &net.raw, &net.probs, net.delta_beta);
         let mut twins = TwinOutcome::default();
         if let Some((h, r)) = refined.best.take() {
-            let (r, outcome) = check_twins(&self.refiner, &finite, r, &self.config.twins);
+            let (r, outcome) = check_twins(&self.refiner, cloud, r, &self.config.twins);
             refined.best = Some((h, r));
             twins = outcome;
         }
-        let refinement_ms = ms(t);
-        let mut estimate = CnnEstimate {
-            t_sensor_target_raw: raw,
-            t_sensor_target: raw,
-            f_conv_m2: f64::INFINITY,
-            accepted: false,
-            twins,
-            top_class,
-            top_probability,
-            points: finite.len(),
-            points_in_roi: image.points_in_roi,
-            hypothesis: 0,
-            hypotheses_refined: refined.tried,
-            ndt_iterations: 0,
-            ndt_converged: false,
-            refinement_error: None,
-            time_ms: Timings {
-                preprocess: preprocess_ms,
-                inference: inference_ms,
-                refinement: refinement_ms,
-                total: ms(start),
-            },
-            fconv_ms: 0.0,
-        };
+        (refined, twins)
+    }
+
+    /// Puts the best refinement of `refined` in `estimate` (with its
+    /// f_CONV check), or, none having succeeded, the first refinement error.
+    fn report_refinement(&self, estimate: &mut CnnEstimate, refined: Hypotheses) {
         match refined.best {
             Some((h, r)) => {
                 estimate.t_sensor_target = r.t_sensor_target;
@@ -310,7 +353,6 @@ impl CnnEstimator {
             }
             None => estimate.refinement_error = refined.error,
         }
-        Ok(estimate)
     }
 
     /// Refines Γ_sym's pose, then the other modes of `probs` (same position)
@@ -409,6 +451,47 @@ impl CnnEstimator {
             .unwrap_or_else(PoisonError::into_inner)
             .engine()
     }
+}
+
+/// The estimate before its refinement is reported: the network's pose
+/// everywhere, f_CONV infinite, not accepted.
+fn unrefined_estimate(
+    net: &NetworkPose,
+    points: usize,
+    points_in_roi: usize,
+    hypotheses_refined: usize,
+    twins: TwinOutcome,
+    time_ms: Timings,
+) -> CnnEstimate {
+    CnnEstimate {
+        t_sensor_target_raw: net.raw,
+        t_sensor_target: net.raw,
+        f_conv_m2: f64::INFINITY,
+        accepted: false,
+        twins,
+        top_class: net.top_class,
+        top_probability: net.top_probability,
+        points,
+        points_in_roi,
+        hypothesis: 0,
+        hypotheses_refined,
+        ndt_iterations: 0,
+        ndt_converged: false,
+        refinement_error: None,
+        time_ms,
+        fconv_ms: 0.0,
+    }
+}
+
+/// The class of largest probability in `probs` and its probability
+/// (`(0, 0.0)` for no class).
+fn top_class(probs: &[f32]) -> (usize, f32) {
+    probs
+        .iter()
+        .copied()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap_or((0, 0.0))
 }
 
 #[cfg(test)]
