@@ -93,14 +93,28 @@ impl GroundState {
         self.received.get("pose").copied().unwrap_or(0)
     }
 
-    /// The live table.
+    /// The live table: a summary line, then the pose table and the health
+    /// table, each only once something of its kind has arrived.
     pub fn render(&self, elapsed: Duration) -> String {
+        let mut s = self.summary_line(elapsed);
+        if !self.poses.is_empty() {
+            s.push_str(&self.pose_table().render());
+        }
+        if !self.health.is_empty() {
+            s.push_str(&self.health_table().render());
+        }
+        s
+    }
+
+    /// "-- ground T s: key N, ... (malformed M)", newline included, with
+    /// "nothing yet" in place of the counts before the first message.
+    fn summary_line(&self, elapsed: Duration) -> String {
         let counts: Vec<String> = self
             .received
             .iter()
             .map(|(k, v)| format!("{k} {v}"))
             .collect();
-        let mut s = format!(
+        format!(
             "-- ground {:.1} s: {} (malformed {})\n",
             elapsed.as_secs_f64(),
             if counts.is_empty() {
@@ -109,78 +123,103 @@ impl GroundState {
                 counts.join(", ")
             },
             self.malformed
-        );
-        if !self.poses.is_empty() {
-            let mut t = Table::new(&[
-                "prefix",
-                "tracker",
-                "frame",
-                "status",
-                "yaw deg",
-                "pitch deg",
-                "roll deg",
-                "range m",
-                "ang err deg",
-                "pos err cm",
-                "latency ms",
-            ]);
-            for ((prefix, inst), p) in &self.poses {
-                let e = self.errors.get(&(prefix.clone(), inst.clone()));
-                let range = p
-                    .p_sensor_target_m
-                    .iter()
-                    .map(|x| x * x)
-                    .sum::<f64>()
-                    .sqrt();
-                t.row(vec![
-                    prefix.clone(),
-                    inst.clone(),
-                    p.sequence.to_string(),
-                    p.status.clone(),
-                    num(p.euler_321_deg[0], 1),
-                    num(p.euler_321_deg[1], 1),
-                    num(p.euler_321_deg[2], 1),
-                    num(range, 2),
-                    e.map_or("-".into(), |e| num(e.ang_err_deg, 2)),
-                    e.map_or("-".into(), |e| num(e.pos_err_cm, 2)),
-                    p.latency_ms.map_or("-".into(), |l| num(l, 2)),
-                ]);
-            }
-            s.push_str(&t.render());
-        }
-        if !self.health.is_empty() {
-            let mut t = Table::new(&[
-                "prefix",
-                "instance",
-                "service",
-                "state",
-                "in",
-                "out",
-                "rejected",
-                "errors",
-                "last frame",
-            ]);
-            for ((prefix, inst), h) in &self.health {
-                let rejected = h.rejected_non_finite
-                    + h.rejected_empty
-                    + h.rejected_oversized
-                    + h.rejected_wire;
-                t.row(vec![
-                    prefix.clone(),
-                    inst.clone(),
-                    h.service.clone(),
-                    h.state.clone(),
-                    h.frames_in.to_string(),
-                    h.frames_out.to_string(),
-                    rejected.to_string(),
-                    h.errors.to_string(),
-                    h.last_frame.to_string(),
-                ]);
-            }
-            s.push_str(&t.render());
-        }
-        s
+        )
     }
+
+    /// One row per (prefix, tracker): its latest pose next to the latest
+    /// errors of the same tracker, if any.
+    fn pose_table(&self) -> Table {
+        let mut t = Table::new(&POSE_COLUMNS);
+        for ((prefix, inst), p) in &self.poses {
+            let e = self.errors.get(&(prefix.clone(), inst.clone()));
+            t.row(pose_row(prefix, inst, p, e));
+        }
+        t
+    }
+
+    /// One row per (prefix, instance): its latest heartbeat.
+    fn health_table(&self) -> Table {
+        let mut t = Table::new(&HEALTH_COLUMNS);
+        for ((prefix, inst), h) in &self.health {
+            t.row(health_row(prefix, inst, h));
+        }
+        t
+    }
+}
+
+/// Column headers of the pose table, in the order of [`pose_row`].
+const POSE_COLUMNS: [&str; 11] = [
+    "prefix",
+    "tracker",
+    "frame",
+    "status",
+    "yaw deg",
+    "pitch deg",
+    "roll deg",
+    "range m",
+    "ang err deg",
+    "pos err cm",
+    "latency ms",
+];
+
+/// Column headers of the health table, in the order of [`health_row`].
+const HEALTH_COLUMNS: [&str; 9] = [
+    "prefix",
+    "instance",
+    "service",
+    "state",
+    "in",
+    "out",
+    "rejected",
+    "errors",
+    "last frame",
+];
+
+/// The cells of one pose row: Euler angles to 0.1°, range to the target in
+/// metres, and `-` for errors not received yet or an unknown latency.
+fn pose_row(
+    prefix: &str,
+    inst: &str,
+    p: &TelemetryPose,
+    e: Option<&TelemetryErrors>,
+) -> Vec<String> {
+    let range = p
+        .p_sensor_target_m
+        .iter()
+        .map(|x| x * x)
+        .sum::<f64>()
+        .sqrt();
+    vec![
+        prefix.to_string(),
+        inst.to_string(),
+        p.sequence.to_string(),
+        p.status.clone(),
+        num(p.euler_321_deg[0], 1),
+        num(p.euler_321_deg[1], 1),
+        num(p.euler_321_deg[2], 1),
+        num(range, 2),
+        e.map_or("-".into(), |e| num(e.ang_err_deg, 2)),
+        e.map_or("-".into(), |e| num(e.pos_err_cm, 2)),
+        p.latency_ms.map_or("-".into(), |l| num(l, 2)),
+    ]
+}
+
+/// The cells of one health row; "rejected" sums the frames rejected for
+/// any reason (non-finite points, empty, oversized, refused by the codec).
+fn health_row(prefix: &str, inst: &str, h: &TelemetryHealth) -> Vec<String> {
+    let rejected =
+        h.rejected_non_finite + h.rejected_empty + h.rejected_oversized + h.rejected_wire;
+    vec![
+        prefix.to_string(),
+        inst.to_string(),
+        h.service.clone(),
+        h.state.clone(),
+        h.frames_in.to_string(),
+        h.frames_out.to_string(),
+        rejected.to_string(),
+        h.errors.to_string(),
+        h.last_frame.to_string(),
+    ]
 }
 
 /// A flag set by SIGINT or SIGTERM, so the tool ends with its final table.
@@ -318,5 +357,102 @@ mod tests {
         s.on_message("spacepose/p/telemetry/health/ingest", b"{}");
         assert_eq!(s.received["health"], 1);
         assert!(s.render(Duration::from_secs(1)).contains("pose 2"));
+    }
+
+    /// A pose of `instance` at (3, 4, 12) m, i.e. 13 m away.
+    fn pose(instance: &str, latency_ms: Option<f64>) -> TelemetryPose {
+        serde_json::from_value(json!({
+            "schema_version": 1, "instance": instance, "sequence": 42, "t_s": 4.2,
+            "status": "degraded", "mode": "track", "q_sensor_target": [1.0, 0.0, 0.0, 0.0],
+            "p_sensor_target_m": [3.0, 4.0, 12.0], "euler_321_deg": [10.04, -20.06, 179.96],
+            "sigma_rot_deg": [0.1, 0.1, 0.1], "sigma_pos_cm": [1.0, 1.0, 1.0],
+            "cost": 0.5, "iterations": 7, "inliers": 100, "points_used": 200,
+            "preprocess_ms": 1.0, "registration_ms": 2.0, "total_ms": 3.0,
+            "latency_ms": latency_ms, "published_ns": 0
+        }))
+        .unwrap()
+    }
+
+    /// Errors of `instance` against truth.
+    fn errors(instance: &str, ang_err_deg: f64, pos_err_cm: f64) -> TelemetryErrors {
+        serde_json::from_value(json!({
+            "schema_version": 1, "instance": instance, "sequence": 42, "t_s": 4.2,
+            "status": "degraded", "ang_err_deg": ang_err_deg, "pos_err_cm": pos_err_cm,
+            "latency_ms": null
+        }))
+        .unwrap()
+    }
+
+    /// The whitespace-separated cells of the row of `prefix` and `instance`.
+    fn cells<'a>(text: &'a str, prefix: &str, instance: &str) -> Vec<&'a str> {
+        let row = text
+            .lines()
+            .map(|l| l.split_whitespace().collect::<Vec<_>>())
+            .find(|c| c.len() > 2 && c[0] == prefix && c[1] == instance);
+        row.unwrap_or_else(|| panic!("no row {prefix} {instance} in\n{text}"))
+    }
+
+    #[test]
+    fn an_empty_state_renders_only_the_summary_line() {
+        let mut s = GroundState::default();
+        assert_eq!(
+            s.render(Duration::from_millis(1500)),
+            "-- ground 1.5 s: nothing yet (malformed 0)\n"
+        );
+        s.malformed = 3;
+        s.received.insert("truth".into(), 2);
+        s.received.insert("filter".into(), 5);
+        assert_eq!(
+            s.render(Duration::from_secs(60)),
+            "-- ground 60.0 s: filter 5, truth 2 (malformed 3)\n"
+        );
+    }
+
+    #[test]
+    fn pose_rows_show_range_and_the_errors_of_the_same_tracker() {
+        let mut s = GroundState::default();
+        let key = |i: &str| ("demo".to_string(), i.to_string());
+        s.poses.insert(key("a"), pose("a", Some(1.234)));
+        s.poses.insert(key("b"), pose("b", None));
+        s.errors.insert(key("a"), errors("a", 0.126, 3.5));
+        s.errors.insert(key("gone"), errors("gone", 9.0, 9.0));
+        let text = s.render(Duration::ZERO);
+        assert!(text.contains("latency ms"), "{text}");
+        assert!(!text.contains("last frame"), "no health table yet:\n{text}");
+        let a = [
+            "demo", "a", "42", "degraded", "10.0", "-20.1", "180.0", "13.00",
+        ];
+        assert_eq!(
+            cells(&text, "demo", "a"),
+            [&a[..], &["0.13", "3.50", "1.23"]].concat()
+        );
+        let b = &cells(&text, "demo", "b");
+        assert_eq!(b[..8], a.map(|c| if c == "a" { "b" } else { c }));
+        assert_eq!(b[8..], ["-", "-", "-"]);
+        assert!(
+            !text.contains("gone"),
+            "errors without a pose get no row:\n{text}"
+        );
+    }
+
+    #[test]
+    fn health_rows_sum_every_kind_of_rejection() {
+        let mut s = GroundState::default();
+        let h: TelemetryHealth = serde_json::from_value(json!({
+            "schema_version": 1, "service": "tracker", "instance": "t1", "state": "running",
+            "pid": 7, "sequence": 3, "last_frame": 99, "uptime_s": 1.0, "frames_in": 120,
+            "frames_out": 110, "rejected_non_finite": 1, "rejected_empty": 20,
+            "rejected_oversized": 300, "rejected_wire": 4000, "errors": 5, "published_ns": 0
+        }))
+        .unwrap();
+        s.health.insert(("demo".into(), "t1".into()), h);
+        let text = s.render(Duration::ZERO);
+        assert!(!text.contains("latency ms"), "no pose table yet:\n{text}");
+        assert_eq!(
+            cells(&text, "demo", "t1"),
+            [
+                "demo", "t1", "tracker", "running", "120", "110", "4321", "5", "99"
+            ]
+        );
     }
 }
