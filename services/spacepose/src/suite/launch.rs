@@ -279,6 +279,15 @@ impl RunningSuite {
             .map(|i| i.log.clone())
     }
 
+    /// A suite of no instance yet, for unit tests that spawn into it.
+    #[cfg(test)]
+    pub(crate) fn empty(state: RunState) -> Self {
+        Self {
+            state,
+            children: Vec::new(),
+        }
+    }
+
     /// Leaves the processes running (after `up`): they are reparented.
     pub fn detach(self) -> RunState {
         self.state

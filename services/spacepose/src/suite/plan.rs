@@ -141,6 +141,22 @@ pub fn plan(
     let names = Names::new(&descriptor.prefix)
         .map_err(|e| problems.push(format!("prefix: {e}")))
         .ok();
+    check_services_and_hosts(descriptor, &mut problems);
+    check_timing(descriptor, &mut problems);
+    problems.extend(descriptor.restart.problems());
+    check_instance_names(descriptor, &mut problems);
+    check_topics(descriptor, &mut problems);
+    let instances = plan_instances(descriptor, search, check, &mut problems);
+    match names {
+        Some(names) if problems.is_empty() => Ok(validated_plan(descriptor, names, instances)),
+        _ => Err(Problems(problems)),
+    }
+}
+
+/// The descriptor has services and is not partitioned: a partitioned one is
+/// started one host's part at a time (`up --host`), and only its services
+/// name a host.
+fn check_services_and_hosts(descriptor: &Descriptor, problems: &mut Vec<String>) {
     if descriptor.services.is_empty() {
         problems.push("no [[service]] entries".to_string());
     }
@@ -156,6 +172,11 @@ pub fn plan(
             s.name
         ));
     }
+}
+
+/// The health timeout is a positive duration, the heartbeat period at least
+/// 1 ms, and a hang timeout, when given, longer than the heartbeat period.
+fn check_timing(descriptor: &Descriptor, problems: &mut Vec<String>) {
     if !(descriptor.health_timeout_s.is_finite() && descriptor.health_timeout_s > 0.0) {
         problems.push(format!(
             "health_timeout_s must be a positive number of seconds, got {}",
@@ -171,9 +192,17 @@ pub fn plan(
     {
         problems.push("hang_timeout_ms must be longer than heartbeat_ms".to_string());
     }
-    problems.extend(descriptor.restart.problems());
-    check_instance_names(descriptor, &mut problems);
-    check_topics(descriptor, &mut problems);
+}
+
+/// The instances of the descriptor's services whose binary was found, in
+/// descriptor order; a missing binary or (with [`ConfigCheck::Run`]) a
+/// configuration its binary rejects is a problem.
+fn plan_instances(
+    descriptor: &Descriptor,
+    search: &BinarySearch,
+    check: ConfigCheck,
+    problems: &mut Vec<String>,
+) -> Vec<PlannedInstance> {
     let mut instances = Vec::new();
     for s in &descriptor.services {
         let binary = match search.resolve(s.binary.as_deref(), &s.kind.binary_name()) {
@@ -201,24 +230,29 @@ pub fn plan(
             restart_policy: s.restart_policy.unwrap_or(descriptor.restart.policy),
         });
     }
-    match names {
-        Some(names) if problems.is_empty() => Ok(Plan {
-            names,
-            heartbeat_ms: descriptor.heartbeat_ms,
-            health_timeout: Duration::from_secs_f64(descriptor.health_timeout_s),
-            hang_timeout: Duration::from_millis(
-                descriptor
-                    .hang_timeout_ms
-                    .unwrap_or(3 * descriptor.heartbeat_ms + 100),
-            ),
-            restart: descriptor.restart.clone(),
-            zenoh: descriptor.zenoh.clone(),
-            instances,
-        }),
-        _ => Err(Problems(problems)),
+    instances
+}
+
+/// The plan of a descriptor without problems; the hang timeout defaults to
+/// 3 heartbeat periods + 100 ms.
+fn validated_plan(descriptor: &Descriptor, names: Names, instances: Vec<PlannedInstance>) -> Plan {
+    Plan {
+        names,
+        heartbeat_ms: descriptor.heartbeat_ms,
+        health_timeout: Duration::from_secs_f64(descriptor.health_timeout_s),
+        hang_timeout: Duration::from_millis(
+            descriptor
+                .hang_timeout_ms
+                .unwrap_or(3 * descriptor.heartbeat_ms + 100),
+        ),
+        restart: descriptor.restart.clone(),
+        zenoh: descriptor.zenoh.clone(),
+        instances,
     }
 }
 
+/// Every instance name is file-safe (it names the run directory's files),
+/// a valid bus [`Name`], and used once.
 fn check_instance_names(descriptor: &Descriptor, problems: &mut Vec<String>) {
     let mut seen = BTreeSet::new();
     for s in &descriptor.services {
@@ -365,5 +399,105 @@ mod tests {
         assert!(text.contains("\"Bad_Name\""), "{text}");
         assert!(text.contains("/nonexistent/spacepose-filter"), "{text}");
         assert!(text.contains("\"pose\""), "{text}");
+    }
+
+    #[test]
+    fn descriptor_level_problems_are_listed_in_order() {
+        let d = Descriptor::parse(
+            "prefix = \"Bad Prefix\"\nheartbeat_ms = 0\nhealth_timeout_s = -1.0\n\
+             hang_timeout_ms = 0\n[restart]\nwindow_s = 0.0\n\
+             [[service]]\nname = \"ingest\"\nkind = \"ingest\"\nbinary = \"/bin/sh\"\nhost = \"a\"\n",
+        )
+        .unwrap();
+        let e = plan(&d, &search(), ConfigCheck::Skip).unwrap_err();
+        let prefix = Names::new("Bad Prefix").unwrap_err();
+        assert_eq!(
+            e.0[..6],
+            [
+                format!("prefix: {prefix}"),
+                "service \"ingest\" names a host, but the descriptor has no [[host]] tables"
+                    .to_string(),
+                "health_timeout_s must be a positive number of seconds, got -1".to_string(),
+                "heartbeat_ms must be >= 1".to_string(),
+                "hang_timeout_ms must be longer than heartbeat_ms".to_string(),
+                "restart.window_s must be a positive number of seconds, got 0".to_string(),
+            ]
+        );
+        // Then the topic check: ingest's raw_cloud has no producer.
+        assert_eq!(e.0.len(), 7, "{e}");
+        assert!(e.0[6].contains("raw_cloud"), "{e}");
+        assert!(
+            e.to_string()
+                .starts_with("the deployment descriptor has 7 problem(s):")
+        );
+    }
+
+    #[test]
+    fn an_empty_or_partitioned_descriptor_is_refused() {
+        let e = plan(
+            &Descriptor::parse("prefix = \"t\"\n").unwrap(),
+            &search(),
+            ConfigCheck::Skip,
+        )
+        .unwrap_err();
+        assert_eq!(e.0, ["no [[service]] entries"]);
+        let mut d = descriptor("sim lidar-sim\ningest ingest");
+        let hosts =
+            Descriptor::parse("prefix = \"t\"\n[[host]]\nname = \"a\"\n[[host]]\nname = \"b\"\n")
+                .unwrap()
+                .hosts;
+        d.hosts = hosts;
+        d.services[0].host = Some("a".into());
+        let e = plan(&d, &search(), ConfigCheck::Skip).unwrap_err();
+        // Only the partition is reported, not the service's host.
+        assert_eq!(e.0.len(), 1, "{e}");
+        assert!(
+            e.0[0].starts_with("the descriptor is partitioned over hosts a, b: ")
+                && e.0[0].ends_with("`spacepose up --host NAME`"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn timeouts_and_restart_policies_come_from_the_descriptor() {
+        let mut d = descriptor("sim lidar-sim\ningest ingest");
+        d.heartbeat_ms = 200;
+        d.health_timeout_s = 2.5;
+        d.restart.policy = Policy::Always;
+        d.restart.max_restarts = 2;
+        d.services[1].restart_policy = Some(Policy::Never);
+        let p = plan(&d, &search(), ConfigCheck::Skip).unwrap();
+        assert_eq!(p.names.prefix(), "t");
+        assert_eq!(p.heartbeat_ms, 200);
+        assert_eq!(p.health_timeout, Duration::from_millis(2500));
+        // Default: 3 heartbeat periods + 100 ms.
+        assert_eq!(p.hang_timeout, Duration::from_millis(700));
+        assert_eq!(p.restart, d.restart);
+        assert_eq!(p.zenoh, d.zenoh);
+        let names: Vec<&str> = p.instances.iter().map(|i| i.name.as_str()).collect();
+        assert_eq!(names, ["sim", "ingest"]);
+        assert_eq!(p.instances[0].restart_policy, Policy::Always);
+        assert_eq!(p.instances[1].restart_policy, Policy::Never);
+        assert_eq!(p.instances[1].binary, PathBuf::from("/bin/sh"));
+        d.hang_timeout_ms = Some(201);
+        let p = plan(&d, &search(), ConfigCheck::Skip).unwrap();
+        assert_eq!(p.hang_timeout, Duration::from_millis(201));
+    }
+
+    #[test]
+    fn config_check_runs_each_binary_only_when_asked() {
+        let mut d = descriptor("sim lidar-sim\ningest ingest");
+        d.services[0].binary = Some(PathBuf::from("/bin/true"));
+        d.services[1].binary = Some(PathBuf::from("/bin/false"));
+        let e = plan(&d, &search(), ConfigCheck::Run).unwrap_err();
+        assert_eq!(
+            e.0,
+            [
+                "service \"ingest\" (ingest): invalid config: /bin/false --check failed (exit status: 1)"
+            ]
+        );
+        assert!(plan(&d, &search(), ConfigCheck::Skip).is_ok());
+        d.services[1].binary = Some(PathBuf::from("/bin/true"));
+        assert!(plan(&d, &search(), ConfigCheck::Run).is_ok());
     }
 }

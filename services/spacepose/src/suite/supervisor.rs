@@ -13,7 +13,7 @@ use super::health::HealthWatch;
 use super::kind::ServiceKind;
 use super::launch::RunningSuite;
 use super::plan::{Plan, PlannedInstance};
-use super::restart::{Decision, RestartHistory, Stop};
+use super::restart::{Decision, Policy, RestartHistory, Stop};
 use super::swap::{SwapJob, SwapReport, SwapRequest};
 use anyhow::{Context, Result};
 use iceoryx2::node::NodeView;
@@ -23,6 +23,7 @@ use spacepose_bus::{Bus, Publisher, Subscriber, cleanup_dead_nodes, iceoryx2_con
 use spacepose_messages::{Command, Names, PoseEstimate};
 use std::collections::BTreeMap;
 use std::io::Write;
+use std::process::ExitStatus;
 use std::time::{Duration, Instant};
 
 /// How often dead iceoryx2 nodes are looked for.
@@ -70,6 +71,39 @@ struct Record {
     open_fault: Option<usize>,
     /// Killed by the supervisor for hanging (its exit is part of that fault).
     killed_for_hang: bool,
+}
+
+impl Record {
+    /// Why the process stopped with `status`: hung when the supervisor
+    /// killed it for hanging, whatever the status.
+    fn stop(&self, status: ExitStatus) -> Stop {
+        if self.killed_for_hang {
+            Stop::Hung
+        } else if status.success() {
+            Stop::Clean
+        } else {
+            Stop::Failed(status.to_string())
+        }
+    }
+}
+
+/// What the supervisor reports doing: `restart in N ms`, `leave` or `give up`.
+fn decision_text(decision: Decision) -> String {
+    match decision {
+        Decision::RestartAfter(d) => format!("restart in {} ms", d.as_millis()),
+        Decision::Leave => "leave".to_string(),
+        Decision::GiveUp => "give up".to_string(),
+    }
+}
+
+/// Status of an instance after `decision` about its `stop`: `restarting`,
+/// `exited` (left down after a clean exit) or `failed`.
+fn status_after(decision: Decision, stop: &Stop) -> &'static str {
+    match decision {
+        Decision::RestartAfter(_) => "restarting",
+        Decision::Leave if *stop == Stop::Clean => "exited",
+        _ => "failed",
+    }
 }
 
 /// Supervises a started suite.
@@ -204,6 +238,8 @@ impl Supervisor {
         }
     }
 
+    /// Handles every instance whose process exited, unless its restart is
+    /// already pending (see [`Self::handle_exit`]).
     fn check_exits(&mut self, now: Instant, out: &mut dyn Write) -> Result<()> {
         let names: Vec<String> = self
             .suite
@@ -223,70 +259,105 @@ impl Supervisor {
             let Some(status) = self.suite.try_exit(&name) else {
                 continue;
             };
-            let r = self.records.entry(name.clone()).or_default();
-            if r.retiring {
-                writeln!(out, "supervisor: {name} stopped ({status})")?;
-                self.suite.remove(&name);
-                self.records.remove(&name);
-                continue;
-            }
-            let stop = if r.killed_for_hang {
-                Stop::Hung
-            } else if status.success() {
-                Stop::Clean
-            } else {
-                Stop::Failed(status.to_string())
-            };
-            let fault = match r.open_fault.filter(|_| r.killed_for_hang) {
-                Some(f) => f,
-                None => {
-                    self.faults.push(Fault {
-                        instance: name.clone(),
-                        cause: format!("exit: {status}"),
-                        detected_at: now,
-                        restarted_at: None,
-                        healthy_at: None,
-                        decision: String::new(),
-                    });
-                    self.faults.len() - 1
-                }
-            };
-            // Its node is dead now: remove its stale resources at once.
-            self.cleaned_nodes += self.clean_dead_nodes();
-            let policy = self
-                .planned(&name)
-                .map_or(super::restart::Policy::Never, |p| p.restart_policy);
-            let r = self.records.entry(name.clone()).or_default();
-            r.killed_for_hang = false;
-            r.healthy = false;
-            let decision = r.history.decide(&self.plan.restart, policy, &stop, now);
-            let text = match decision {
-                Decision::RestartAfter(d) => {
-                    r.restart_at = Some(now + d);
-                    r.open_fault = Some(fault);
-                    format!("restart in {} ms", d.as_millis())
-                }
-                Decision::Leave => "leave".to_string(),
-                Decision::GiveUp => "give up".to_string(),
-            };
-            self.faults[fault].decision = match decision {
-                Decision::RestartAfter(_) => "restart".into(),
-                _ => text.clone(),
-            };
-            writeln!(
-                out,
-                "supervisor: {name} {} -> {text}",
-                self.faults[fault].cause
-            )?;
-            if let Some(i) = self.suite.index(&name) {
-                self.suite.state.instances[i].status = match decision {
-                    Decision::RestartAfter(_) => "restarting",
-                    Decision::Leave if stop == Stop::Clean => "exited",
-                    _ => "failed",
-                }
-                .into();
-            }
-            self.save_state()?;
+            self.handle_exit(&name, status, now, out)?;
+        }
+        Ok(())
+    }
+
+    /// `name` exited with `status` (detected at `now`): a retiring instance
+    /// is forgotten; any other exit is a fault (the one of its hang, when the
+    /// supervisor killed it), its stale bus resources are removed, and its
+    /// restart policy decides; the decision is reported and saved.
+    fn handle_exit(
+        &mut self,
+        name: &str,
+        status: ExitStatus,
+        now: Instant,
+        out: &mut dyn Write,
+    ) -> Result<()> {
+        let r = self.records.entry(name.to_string()).or_default();
+        if r.retiring {
+            return self.forget_retired(name, status, out);
+        }
+        let stop = r.stop(status);
+        let fault = match r.open_fault.filter(|_| r.killed_for_hang) {
+            Some(f) => f,
+            None => self.push_exit_fault(name, status, now),
+        };
+        // Its node is dead now: remove its stale resources at once.
+        self.cleaned_nodes += self.clean_dead_nodes();
+        let decision = self.decide_restart(name, &stop, fault, now);
+        self.report_decision(name, fault, decision, &stop, out)?;
+        self.save_state()
+    }
+
+    /// Forgets `name`, stopped on purpose (swapped out): its exit is no fault.
+    fn forget_retired(
+        &mut self,
+        name: &str,
+        status: ExitStatus,
+        out: &mut dyn Write,
+    ) -> Result<()> {
+        writeln!(out, "supervisor: {name} stopped ({status})")?;
+        self.suite.remove(name);
+        self.records.remove(name);
+        Ok(())
+    }
+
+    /// Records the fault of `name` exiting with `status` at `now`; returns
+    /// its index in [`Self::faults`].
+    fn push_exit_fault(&mut self, name: &str, status: ExitStatus, now: Instant) -> usize {
+        self.faults.push(Fault {
+            instance: name.to_string(),
+            cause: format!("exit: {status}"),
+            detected_at: now,
+            restarted_at: None,
+            healthy_at: None,
+            decision: String::new(),
+        });
+        self.faults.len() - 1
+    }
+
+    /// Decides by `name`'s restart policy (`never` when it is no longer
+    /// planned) what to do after `stop`. A restart is scheduled, and `fault`
+    /// stays open until the replacement's first heartbeat.
+    fn decide_restart(&mut self, name: &str, stop: &Stop, fault: usize, now: Instant) -> Decision {
+        let policy = self
+            .planned(name)
+            .map_or(Policy::Never, |p| p.restart_policy);
+        let r = self.records.entry(name.to_string()).or_default();
+        r.killed_for_hang = false;
+        r.healthy = false;
+        let decision = r.history.decide(&self.plan.restart, policy, stop, now);
+        if let Decision::RestartAfter(d) = decision {
+            r.restart_at = Some(now + d);
+            r.open_fault = Some(fault);
+        }
+        decision
+    }
+
+    /// Writes `decision` into fault `fault`, reports it to `out` and sets
+    /// the status of `name`.
+    fn report_decision(
+        &mut self,
+        name: &str,
+        fault: usize,
+        decision: Decision,
+        stop: &Stop,
+        out: &mut dyn Write,
+    ) -> Result<()> {
+        let text = decision_text(decision);
+        self.faults[fault].decision = match decision {
+            Decision::RestartAfter(_) => "restart".into(),
+            _ => text.clone(),
+        };
+        writeln!(
+            out,
+            "supervisor: {name} {} -> {text}",
+            self.faults[fault].cause
+        )?;
+        if let Some(i) = self.suite.index(name) {
+            self.suite.state.instances[i].status = status_after(decision, stop).into();
         }
         Ok(())
     }
@@ -552,3 +623,7 @@ impl Supervisor {
         suite.stop(out)
     }
 }
+
+#[cfg(test)]
+#[path = "supervisor_tests.rs"]
+mod tests;
