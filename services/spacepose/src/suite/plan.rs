@@ -163,7 +163,7 @@ fn check_services_and_hosts(descriptor: &Descriptor, problems: &mut Vec<String>)
     if !descriptor.hosts.is_empty() {
         let hosts: Vec<&str> = descriptor.hosts.iter().map(|h| h.name.as_str()).collect();
         problems.push(format!(
-            "the descriptor is partitioned over hosts {}: start each host's part with              `spacepose up --host NAME`",
+            "the descriptor is partitioned over hosts {}: start each host's part with `spacepose up --host NAME`",
             hosts.join(", ")
         ));
     } else if let Some(s) = descriptor.services.iter().find(|s| s.host.is_some()) {

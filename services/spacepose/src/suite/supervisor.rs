@@ -71,6 +71,9 @@ struct Record {
     open_fault: Option<usize>,
     /// Killed by the supervisor for hanging (its exit is part of that fault).
     killed_for_hang: bool,
+    /// Left down (`leave` or `give up`): its exit has been handled, and the
+    /// reaped status that `try_exit` keeps returning is not a new fault.
+    down: bool,
 }
 
 impl Record {
@@ -239,7 +242,7 @@ impl Supervisor {
     }
 
     /// Handles every instance whose process exited, unless its restart is
-    /// already pending (see [`Self::handle_exit`]).
+    /// already pending or it was left down (see [`Self::handle_exit`]).
     fn check_exits(&mut self, now: Instant, out: &mut dyn Write) -> Result<()> {
         let names: Vec<String> = self
             .suite
@@ -249,11 +252,11 @@ impl Supervisor {
             .map(|i| i.name.clone())
             .collect();
         for name in names {
-            let waiting = self
+            let handled = self
                 .records
                 .get(&name)
-                .is_some_and(|r| r.restart_at.is_some());
-            if waiting {
+                .is_some_and(|r| r.restart_at.is_some() || r.down);
+            if handled {
                 continue;
             }
             let Some(status) = self.suite.try_exit(&name) else {
@@ -329,9 +332,12 @@ impl Supervisor {
         r.killed_for_hang = false;
         r.healthy = false;
         let decision = r.history.decide(&self.plan.restart, policy, stop, now);
-        if let Decision::RestartAfter(d) = decision {
-            r.restart_at = Some(now + d);
-            r.open_fault = Some(fault);
+        match decision {
+            Decision::RestartAfter(d) => {
+                r.restart_at = Some(now + d);
+                r.open_fault = Some(fault);
+            }
+            Decision::Leave | Decision::GiveUp => r.down = true,
         }
         decision
     }
@@ -561,9 +567,14 @@ impl Supervisor {
         if let Some(r) = self.records.get_mut(name) {
             r.retiring = true;
             r.restart_at = None;
+            // A left-down instance's exit is handled again, as retiring.
+            r.down = false;
         }
         self.plan.instances.retain(|i| i.name != name);
-        self.suite.signal(name, Signal::TERM);
+        // An exited process's group id may belong to another process now.
+        if self.suite.try_exit(name).is_none() {
+            self.suite.signal(name, Signal::TERM);
+        }
     }
 
     /// True once `name` has exited and been forgotten.

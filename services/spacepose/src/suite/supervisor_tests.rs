@@ -280,6 +280,45 @@ fn too_many_restarts_give_up() {
         let r = &sup.records[name];
         assert_eq!((r.restart_at, r.open_fault), (None, None), "{name}");
     }
+    // Given up: the next steps do not report the same exit again.
+    assert_eq!(check_exits(&mut sup, now + Duration::from_secs(1)), "");
+    assert_eq!(sup.faults.len(), 2);
+    finish(sup);
+}
+
+#[test]
+fn an_instance_left_down_is_not_a_new_fault_at_every_step() {
+    let plan = test_plan(
+        "leftdown",
+        &[
+            ("clean", Path::new("/bin/true"), Policy::OnFailure),
+            ("never", Path::new("/bin/false"), Policy::Never),
+        ],
+        5,
+    );
+    let mut sup = supervisor(plan);
+    wait_exited(&sup, &["clean", "never"]);
+    let now = Instant::now();
+    assert_eq!(
+        check_exits(&mut sup, now),
+        "supervisor: clean exit: exit status: 0 -> leave\n\
+         supervisor: never exit: exit status: 1 -> leave\n"
+    );
+    for step in 1..4 {
+        let later = now + Duration::from_secs(step);
+        assert_eq!(check_exits(&mut sup, later), "", "step {step}");
+    }
+    assert_eq!(sup.faults.len(), 2);
+    let st = statuses(&sup);
+    assert_eq!((st[0].1.as_str(), st[1].1.as_str()), ("exited", "failed"));
+    // Swapped out while down: forgotten as any retired instance is.
+    sup.retire("never");
+    assert_eq!(
+        check_exits(&mut sup, now + Duration::from_secs(5)),
+        "supervisor: never stopped (exit status: 1)\n"
+    );
+    assert_eq!(statuses(&sup).len(), 1);
+    assert_eq!(sup.faults.len(), 2);
     finish(sup);
 }
 
