@@ -31,6 +31,41 @@ struct LastPose {
     t_sensor_target: Pose,
 }
 
+/// A frame's registration and how it was obtained ([`Tracker::measure`]).
+struct Measured {
+    registration: Registration,
+    /// The cloud was motion-compensated by the prediction (Eq. 12).
+    compensated: bool,
+    /// Points the registration saw.
+    points_used: usize,
+    /// Fitted by the stall fallback.
+    fallback: bool,
+    preprocess_ms: f64,
+    /// Registration, the fallback included.
+    registration_ms: f64,
+}
+
+/// Why a frame carried no measurement, and what is known of it.
+struct Missing {
+    reason: String,
+    /// Points left after pre-processing (0 when it failed or was not the
+    /// cause).
+    points_used: usize,
+    /// 0 when pre-processing was not the cause.
+    preprocess_ms: f64,
+}
+
+impl Missing {
+    /// No measurement for `reason`, pre-processing aside.
+    fn because(reason: String) -> Self {
+        Self {
+            reason,
+            points_used: 0,
+            preprocess_ms: 0.0,
+        }
+    }
+}
+
 /// Follows the target frame after frame. Not thread-safe by design: one
 /// tracker per stream of frames.
 pub struct Tracker {
@@ -169,13 +204,48 @@ impl Tracker {
                 started,
             ));
         }
-        let pre = Instant::now();
-        let (cloud, compensated) = match self.preprocess(points, &prediction) {
-            Ok(c) => c,
-            Err(e) => {
-                return Ok(self.declare_lost(&prediction, points.len(), e.to_string(), started));
+        let scan = ScanTimes {
+            start_s: scan_start,
+            end_s: scan_end,
+        };
+        let m = match self.measure(points, &prediction, &last, &scan) {
+            Ok(m) => m,
+            Err(missing) => {
+                let mut out = self.declare_lost(&prediction, points.len(), missing.reason, started);
+                (out.points_used, out.timings.preprocess_ms) =
+                    (missing.points_used, missing.preprocess_ms);
+                return Ok(out);
             }
         };
+        self.holding = m.registration.degenerate_directions > 0;
+        let registration = self.follow_held_rate(scan_end, m.registration);
+        let counts = (points.len(), m.points_used);
+        let mut out = self.assess(registration, m.compensated, &prediction, scan_end, counts)?;
+        out.fallback = m.fallback;
+        self.record_tracked(&out);
+        out.timings = Timings {
+            preprocess_ms: m.preprocess_ms,
+            registration_ms: m.registration_ms,
+            total_ms: ms(started),
+        };
+        Ok(out)
+    }
+
+    /// Pre-processing and registration of one frame (with the stall
+    /// fallback), or why there is no measurement: pre-processing failed, too
+    /// few points are left (`loss.min_points`: the target is not in view),
+    /// or the registration failed.
+    fn measure(
+        &mut self,
+        points: &[Point],
+        prediction: &Prediction,
+        last: &LastPose,
+        scan: &ScanTimes,
+    ) -> Result<Measured, Missing> {
+        let pre = Instant::now();
+        let (cloud, compensated) = self
+            .preprocess(points, prediction)
+            .map_err(|e| Missing::because(e.to_string()))?;
         let preprocess_ms = ms(pre);
         if cloud.len() < self.config.loss.min_points {
             let reason = format!(
@@ -184,50 +254,44 @@ impl Tracker {
                 cloud.len(),
                 self.config.loss.min_points
             );
-            let mut out = self.declare_lost(&prediction, points.len(), reason, started);
-            (out.points_used, out.timings.preprocess_ms) = (cloud.len(), preprocess_ms);
-            return Ok(out);
+            let points_used = cloud.len();
+            return Err(Missing {
+                reason,
+                points_used,
+                preprocess_ms,
+            });
         }
         let reg_start = Instant::now();
-        let (start_s, end_s) = (scan_start, scan_end);
-        let scan = ScanTimes { start_s, end_s };
-        let registration = match self.register(&cloud, compensated, &prediction, &last, &scan) {
-            Ok(r) => r,
-            Err(e) => {
-                return Ok(self.declare_lost(&prediction, points.len(), e.to_string(), started));
-            }
-        };
-        let (registration, compensated, points_used, fallback) = match self.stall_fallback(
-            points,
-            &registration,
-            compensated,
-            &prediction,
-            &last,
-            &scan,
-        ) {
+        let registration = self
+            .register(&cloud, compensated, prediction, last, scan)
+            .map_err(|e| Missing::because(e.to_string()))?;
+        let fallback =
+            self.stall_fallback(points, &registration, compensated, prediction, last, scan);
+        let (registration, compensated, points_used, fallback) = match fallback {
             Some((r, n)) => (r, true, n, true),
             None => (registration, compensated, cloud.len(), false),
         };
-        let registration_ms = ms(reg_start);
-        self.holding = registration.degenerate_directions > 0;
-        let registration = self.follow_held_rate(scan_end, registration);
-        let counts = (points.len(), points_used);
-        let mut out = self.assess(registration, compensated, &prediction, scan_end, counts)?;
-        out.fallback = fallback;
+        Ok(Measured {
+            registration,
+            compensated,
+            points_used,
+            fallback,
+            preprocess_ms,
+            registration_ms: ms(reg_start),
+        })
+    }
+
+    /// A frame reported `tracking` adds its pose to the history the held
+    /// rotation's rate is fitted on.
+    fn record_tracked(&mut self, out: &TrackOutput) {
         if let (TrackStatus::Tracking, Some(r)) = (out.status, out.registration.as_ref()) {
             self.held.record(
-                scan_end,
+                out.t,
                 &r.t_target_sensor,
                 r.weakest_lever_arm_m,
                 self.holding,
             );
         }
-        out.timings = Timings {
-            preprocess_ms,
-            registration_ms,
-            total_ms: ms(started),
-        };
-        Ok(out)
     }
 
     /// A result that held one rotation is turned about it to follow the
@@ -532,14 +596,7 @@ impl Tracker {
         let covariance = covariance_sensor_target(&registration.t_target_sensor, &information)
             .map(|c| self.attitude_scaled(c, compensated));
         let mut reasons = self.quality_issues(&registration);
-        let l = &self.config.loss;
-        if innovation_rot_deg > l.max_innovation_rot_deg
-            || innovation_pos_m > l.max_innovation_pos_m
-        {
-            reasons.push(format!(
-                "inconsistent with prediction ({innovation_rot_deg:.1} deg, {innovation_pos_m:.3} m)"
-            ));
-        }
+        reasons.extend(self.inconsistency(innovation_rot_deg, innovation_pos_m));
         if reasons.is_empty() {
             let outcome = self.filter.update(t, &measured, covariance)?;
             if !outcome.fused {
@@ -549,22 +606,7 @@ impl Tracker {
                 ));
             }
         }
-        let status = if reasons.is_empty() {
-            self.consecutive_degraded = 0;
-            TrackStatus::Tracking
-        } else {
-            self.consecutive_degraded += 1;
-            if self.consecutive_degraded >= l.max_consecutive_degraded {
-                self.lost = true;
-                reasons.push(format!(
-                    "{} degraded frames in a row",
-                    self.consecutive_degraded
-                ));
-                TrackStatus::Lost
-            } else {
-                TrackStatus::Degraded
-            }
-        };
+        let status = self.status_after(&mut reasons);
         let (t_sensor_target, covariance) =
             self.published(status, measured, covariance, prediction);
         self.last = Some(LastPose { t, t_sensor_target });
@@ -585,6 +627,39 @@ impl Tracker {
             timings: Timings::default(),
             fallback: false,
         })
+    }
+
+    /// The reason to doubt a measurement that jumps from the prediction by
+    /// more than `loss.max_innovation_*`.
+    fn inconsistency(&self, innovation_rot_deg: f64, innovation_pos_m: f64) -> Option<String> {
+        let l = &self.config.loss;
+        (innovation_rot_deg > l.max_innovation_rot_deg
+            || innovation_pos_m > l.max_innovation_pos_m)
+            .then(|| {
+                format!(
+                    "inconsistent with prediction ({innovation_rot_deg:.1} deg, {innovation_pos_m:.3} m)"
+                )
+            })
+    }
+
+    /// The status after a frame doubted for `reasons` (none: `tracking`):
+    /// `degraded`, or `lost` once `loss.max_consecutive_degraded` frames in
+    /// a row were doubted (that reason is then added).
+    fn status_after(&mut self, reasons: &mut Vec<String>) -> TrackStatus {
+        if reasons.is_empty() {
+            self.consecutive_degraded = 0;
+            return TrackStatus::Tracking;
+        }
+        self.consecutive_degraded += 1;
+        if self.consecutive_degraded < self.config.loss.max_consecutive_degraded {
+            return TrackStatus::Degraded;
+        }
+        self.lost = true;
+        reasons.push(format!(
+            "{} degraded frames in a row",
+            self.consecutive_degraded
+        ));
+        TrackStatus::Lost
     }
 
     /// The pose (and its covariance) the tracker publishes for a frame: the
