@@ -10,4 +10,5 @@ pub mod table;
 pub mod tm;
 mod tm_render;
 pub mod tracking;
+mod tracking_plot;
 mod tracking_render;

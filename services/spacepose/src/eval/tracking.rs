@@ -18,9 +18,8 @@
 //!   (d of seed 004 Eq. 12; a symmetric flip counts as an error when
 //!   tracking) and the distance between estimated and true centre of mass.
 
-use super::plot::{Series, plot_errors};
 use super::stats::{MeanMax, median};
-use super::tracking_render;
+use super::{tracking_plot, tracking_render};
 use crate::cli::{EvalTrackingArgs, ModeArg, ScenarioArg};
 use crate::common::load_target;
 use crate::sim_cmd::progress_bar;
@@ -31,9 +30,11 @@ use serde::Serialize;
 use spacepose_lidar_sim::{Frame, LidarSimulator, ReturnKind, SensorConfig};
 use spacepose_registration::NdtMapParams;
 use spacepose_scenario::{Scenario, ScenarioConfig, build};
+use spacepose_target::Target;
 use spacepose_tracker::{TrackStatus, Tracker, TrackerConfig, TrackingMode, TrackingModel};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// Spacing of the model cloud sampled from the target mesh (m).
 pub const MODEL_SPACING_M: f64 = 0.015;
@@ -181,23 +182,67 @@ pub struct TrackingReport {
     pub modes: BTreeMap<String, ModeReport>,
 }
 
+/// Frames simulated together (in parallel) before the trackers see them.
+const BATCH_FRAMES: usize = 8;
+
 /// Runs the evaluation.
 pub fn evaluate(config: &EvalConfig) -> Result<TrackingReport> {
-    if !matches!(
-        config.scenario,
-        ScenarioArg::SlowSpin | ScenarioArg::Tumbling
-    ) {
+    check_scenario(config.scenario)?;
+    let target = load_target(&config.target.0, config.target.1)?;
+    let model = build_model(&target)?;
+    let scenario = build_scenario(config)?;
+    let frames = frame_count(config, scenario.natural_frame_count())?;
+    let simulator = build_simulator(&target, scenario.as_ref())?;
+    let end_times: Vec<f64> =
+        scenario.frame_end_times(config.first_frame + frames)[config.first_frame..].to_vec();
+    let mut trackers = start_trackers(
+        config,
+        &model,
+        scenario.as_ref(),
+        end_times[0] - scenario.frame_period_s(),
+    )?;
+    let tracked = track_frames(
+        config,
+        &simulator,
+        scenario.as_ref(),
+        &end_times,
+        &mut trackers,
+    )?;
+    Ok(report(
+        config,
+        scenario.name(),
+        target.name(),
+        frames,
+        tracked,
+    ))
+}
+
+/// Fails unless `scenario` is one the tracking evaluation runs on.
+fn check_scenario(scenario: ScenarioArg) -> Result<()> {
+    if !matches!(scenario, ScenarioArg::SlowSpin | ScenarioArg::Tumbling) {
         bail!("tracking is evaluated on slow-spin or tumbling (seed 000 §4.3-4.4)");
     }
-    let target = load_target(&config.target.0, config.target.1)?;
+    Ok(())
+}
+
+/// The trackers' model: the target's surface sampled every
+/// [`MODEL_SPACING_M`] and its NDT map.
+fn build_model(target: &Target) -> Result<TrackingModel> {
     let model_cloud = target.sample_surface(MODEL_SPACING_M, 0);
-    let model = TrackingModel::build(&model_cloud, &NdtMapParams::default())
-        .context("building the NDT map")?;
+    TrackingModel::build(&model_cloud, &NdtMapParams::default()).context("building the NDT map")
+}
+
+/// The configured scenario, with the evaluation's seed and compression.
+fn build_scenario(config: &EvalConfig) -> Result<Box<dyn Scenario>> {
     let mut scenario_config = ScenarioConfig::default_for(config.scenario.kind());
     scenario_config.seed = config.seed;
     scenario_config.compression = config.compression;
-    let scenario = build(&scenario_config).context("invalid scenario")?;
-    let total = scenario.natural_frame_count();
+    build(&scenario_config).context("invalid scenario")
+}
+
+/// Frames to run: the configured count, or the rest of the scenario's
+/// `total` frames from the first one. Fails when that is none.
+fn frame_count(config: &EvalConfig, total: usize) -> Result<usize> {
     let frames = config
         .frames
         .unwrap_or(total.saturating_sub(config.first_frame));
@@ -207,56 +252,105 @@ pub fn evaluate(config: &EvalConfig) -> Result<TrackingReport> {
             config.first_frame
         );
     }
+    Ok(frames)
+}
+
+/// A Livox Mid-40 simulator of `target` integrating over one frame period
+/// of `scenario`.
+fn build_simulator(target: &Arc<Target>, scenario: &dyn Scenario) -> Result<LidarSimulator> {
     let mut sensor = SensorConfig::livox_mid40();
     sensor.integration_time_s = scenario.frame_period_s();
-    let simulator =
-        LidarSimulator::new(target.clone(), sensor).context("building the simulator")?;
-    let end_times: Vec<f64> =
-        scenario.frame_end_times(config.first_frame + frames)[config.first_frame..].to_vec();
-    let mut trackers = start_trackers(
-        config,
-        &model,
-        scenario.as_ref(),
-        end_times[0] - scenario.frame_period_s(),
-    )?;
-    let mut records: Vec<Vec<FrameRecord>> = vec![Vec::with_capacity(frames); trackers.len()];
+    LidarSimulator::new(target.clone(), sensor).context("building the simulator")
+}
+
+/// What the frame loop collects: the records of each tracker, in the order
+/// of the trackers, and the per-frame inputs shared by every mode.
+struct Tracked {
+    /// Per-frame records, one series per tracker.
+    records: Vec<Vec<FrameRecord>>,
+    /// Raw points over all frames.
+    points_total: usize,
+    /// Scan blur of each frame (deg; see [`blur_lag_deg`]).
+    lags: Vec<f64>,
+}
+
+/// Simulates the frames ending at `end_times` in batches of
+/// [`BATCH_FRAMES`] and runs every tracker on each, behind a progress bar.
+fn track_frames(
+    config: &EvalConfig,
+    simulator: &LidarSimulator,
+    scenario: &dyn Scenario,
+    end_times: &[f64],
+    trackers: &mut [Tracker],
+) -> Result<Tracked> {
+    let frames = end_times.len();
+    let mut tracked = Tracked {
+        records: vec![Vec::with_capacity(frames); trackers.len()],
+        points_total: 0,
+        lags: Vec::with_capacity(frames),
+    };
     let bar = progress_bar(frames as u64, "tracking");
-    let mut points_total = 0usize;
-    let mut lags = Vec::with_capacity(frames);
-    for (batch_index, batch) in end_times.chunks(8).enumerate() {
-        let first = config.first_frame + batch_index * 8;
-        let simulated = simulate_batch(&simulator, scenario.as_ref(), batch, first, config.seed)?;
+    for (batch_index, batch) in end_times.chunks(BATCH_FRAMES).enumerate() {
+        let first = config.first_frame + batch_index * BATCH_FRAMES;
+        let simulated = simulate_batch(simulator, scenario, batch, first, config.seed)?;
         for (offset, frame) in simulated.iter().enumerate() {
-            points_total += frame.points.len();
-            let lag = blur_lag_deg(scenario.as_ref(), frame);
-            lags.push(lag);
-            for (tracker, out) in trackers.iter_mut().zip(records.iter_mut()) {
-                let mut record = track_frame(tracker, frame, first + offset)?;
-                record.blur_lag_deg = lag;
-                out.push(record);
-            }
+            tracked.push_frame(scenario, frame, first + offset, trackers)?;
             bar.inc(1);
         }
     }
     bar.finish_and_clear();
+    Ok(tracked)
+}
+
+impl Tracked {
+    /// Counts the points and blur of `frame` (scenario frame `index`) and
+    /// appends each tracker's record of it.
+    fn push_frame(
+        &mut self,
+        scenario: &dyn Scenario,
+        frame: &Frame,
+        index: usize,
+        trackers: &mut [Tracker],
+    ) -> Result<()> {
+        self.points_total += frame.points.len();
+        let lag = blur_lag_deg(scenario, frame);
+        self.lags.push(lag);
+        for (tracker, out) in trackers.iter_mut().zip(self.records.iter_mut()) {
+            let mut record = track_frame(tracker, frame, index)?;
+            record.blur_lag_deg = lag;
+            out.push(record);
+        }
+        Ok(())
+    }
+}
+
+/// The report of `frames` frames of `scenario_name` on `target_name`, one
+/// summary per configured mode.
+fn report(
+    config: &EvalConfig,
+    scenario_name: &str,
+    target_name: &str,
+    frames: usize,
+    tracked: Tracked,
+) -> TrackingReport {
     let modes = config
         .modes
         .iter()
-        .zip(records)
+        .zip(tracked.records)
         .map(|(mode, series)| (mode.to_string(), summarise(series, config.warmup)))
         .collect();
-    Ok(TrackingReport {
-        scenario: scenario.name().to_string(),
-        target: target.name().to_string(),
+    TrackingReport {
+        scenario: scenario_name.to_string(),
+        target: target_name.to_string(),
         seed: config.seed,
         frames,
         first_frame: config.first_frame,
         compression: config.compression,
         warmup: config.warmup,
-        mean_points_in: points_total as f64 / frames as f64,
-        blur_lag_deg: MeanMax::of(&lags),
+        mean_points_in: tracked.points_total as f64 / frames as f64,
+        blur_lag_deg: MeanMax::of(&tracked.lags),
         modes,
-    })
+    }
 }
 
 /// One tracker per mode, initialised on the truth at `t0` with zero rates.
@@ -292,6 +386,8 @@ fn start_trackers(
         .collect()
 }
 
+/// Simulates the frames ending at `end_times` in parallel, frame `first + i`
+/// with its own random stream of `seed`.
 fn simulate_batch(
     simulator: &LidarSimulator,
     scenario: &dyn Scenario,
@@ -332,6 +428,8 @@ pub fn blur_lag_deg(scenario: &dyn Scenario, frame: &Frame) -> f64 {
     ang.to_degrees()
 }
 
+/// Runs `tracker` on `frame` (scenario frame `index`) and scores it
+/// against the truth; `blur_lag_deg` is left NaN for the caller to set.
 fn track_frame(tracker: &mut Tracker, frame: &Frame, index: usize) -> Result<FrameRecord> {
     let out = tracker
         .process(&frame.points, frame.scan_start, frame.scan_end)
@@ -379,6 +477,8 @@ fn track_frame(tracker: &mut Tracker, frame: &Frame, index: usize) -> Result<Fra
     })
 }
 
+/// The summary of one mode's per-frame records, `warmup` frames excluded
+/// from the converged statistics.
 fn summarise(series: Vec<FrameRecord>, warmup: usize) -> ModeReport {
     let pick = |f: fn(&FrameRecord) -> f64, skip: usize| -> Vec<f64> {
         series.iter().skip(skip).map(f).collect()
@@ -408,16 +508,24 @@ fn summarise(series: Vec<FrameRecord>, warmup: usize) -> ModeReport {
 
 /// Runs the command.
 pub fn run(args: &EvalTrackingArgs) -> Result<()> {
-    let modes = match args.mode {
-        ModeArg::All => TrackingMode::ALL.to_vec(),
-        ModeArg::Ndt => vec![TrackingMode::Ndt],
-        ModeArg::Deblur => vec![TrackingMode::Deblur],
-        ModeArg::CtNdt => vec![TrackingMode::CtNdt],
-        ModeArg::Icp => vec![TrackingMode::Icp],
-    };
-    let config = EvalConfig {
+    let config = eval_config(args)?;
+    let report = evaluate(&config)?;
+    print!("{}", tracking_render::render(&report));
+    if let Some(path) = &args.json {
+        write_json(path, &report)?;
+    }
+    if let Some(path) = &args.plot {
+        tracking_plot::write_plot(path, &report)?;
+    }
+    Ok(())
+}
+
+/// The evaluation the command-line arguments ask for (reads the tracker
+/// configuration file, if any).
+fn eval_config(args: &EvalTrackingArgs) -> Result<EvalConfig> {
+    Ok(EvalConfig {
         scenario: args.scenario,
-        modes,
+        modes: modes_of(args.mode),
         frames: args.frames.map(|f| f as usize),
         seed: args.seed,
         compression: args.compression,
@@ -432,44 +540,21 @@ pub fn run(args: &EvalTrackingArgs) -> Result<()> {
             .as_deref()
             .map(load_tracker_config)
             .transpose()?,
-    };
-    let report = evaluate(&config)?;
-    print!("{}", tracking_render::render(&report));
-    if let Some(path) = &args.json {
-        write_json(path, &report)?;
-    }
-    if let Some(path) = &args.plot {
-        type Columns = (String, Vec<f64>, Vec<f64>, Vec<f64>, bool);
-        let series: Vec<Columns> = report
-            .modes
-            .iter()
-            .map(|(name, m)| {
-                let t = m.series.iter().map(|r| r.t).collect();
-                let a = m.series.iter().map(|r| r.ang_err_deg).collect();
-                let p = m.series.iter().map(|r| r.pos_err_cm).collect();
-                (name.clone(), t, a, p, m.diverged_frames > 0)
-            })
-            .collect();
-        let refs: Vec<Series<'_>> = series
-            .iter()
-            .map(|(l, t, a, p, diverged)| Series {
-                label: l,
-                t,
-                ang_err_deg: a,
-                pos_err_cm: p,
-                diverged: *diverged,
-            })
-            .collect();
-        let title = format!(
-            "{} ({}), seed {}",
-            report.scenario, report.target, report.seed
-        );
-        plot_errors(path, &title, &refs)?;
-        println!("plot written to {}", path.display());
-    }
-    Ok(())
+    })
 }
 
+/// The tracking modes `mode` selects.
+fn modes_of(mode: ModeArg) -> Vec<TrackingMode> {
+    match mode {
+        ModeArg::All => TrackingMode::ALL.to_vec(),
+        ModeArg::Ndt => vec![TrackingMode::Ndt],
+        ModeArg::Deblur => vec![TrackingMode::Deblur],
+        ModeArg::CtNdt => vec![TrackingMode::CtNdt],
+        ModeArg::Icp => vec![TrackingMode::Icp],
+    }
+}
+
+/// Writes `report` as pretty-printed JSON to `path` and says so.
 fn write_json(path: &PathBuf, report: &TrackingReport) -> Result<()> {
     let text = serde_json::to_string_pretty(report).context("serialising the report")?;
     std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
