@@ -33,58 +33,20 @@ pub(crate) fn run(
     constrained: Option<&Constrained>,
     mut linearise: impl FnMut(&Pose, usize) -> NormalEquations,
 ) -> Result<Registration, RegistrationError> {
-    let no_match = |iteration| RegistrationError::NoCorrespondences {
-        iteration,
-        max_distance_m: params.max_distance_m,
-    };
-    let rot_tol = params.termination_rotation_deg.to_radians();
-    let below = |inc: &Increment, factor: f64| {
-        inc.rotation_rad < rot_tol * factor
-            && inc.translation_m < params.termination_translation_m * factor
-    };
-    let mut stride = params.coarse_stride.max(1);
-    let mut pose = initial;
-    let mut iterations = 0;
-    let mut last = Increment::default();
-    let mut final_ne = None;
-    for it in 0..params.max_iterations {
-        let mut ne = linearise(&pose, stride);
-        if ne.inliers < 6 && stride > 1 {
-            // Too sparse a subset: continue on every point.
-            stride = 1;
-            ne = linearise(&pose, stride);
-        }
-        if ne.inliers == 0 {
-            return Err(no_match(it));
-        }
-        let eps = match constrained {
-            Some(c) => ne.solve_in(&c.basis, it)?,
-            None => ne.solve(it)?,
-        };
-        pose = pose.oplus(&eps); // T ← ε ⊕ T, Eq. (5)
-        iterations = it + 1;
-        last = increment_of(&eps);
-        if stride == 1 && below(&last, 1.0) {
-            final_ne = Some(ne);
-            break;
-        }
-        if stride > 1 && below(&last, params.coarse_switch) {
-            stride = 1;
-        }
-    }
-    let converged = final_ne.is_some();
-    let ne = match final_ne {
+    let run = iterate(initial, params, constrained, &mut linearise)?;
+    let converged = run.final_ne.is_some();
+    let ne = match run.final_ne {
         Some(ne) => ne,
-        None => linearise(&pose, 1),
+        None => linearise(&run.pose, 1),
     };
     if ne.inliers == 0 {
-        return Err(no_match(iterations));
+        return Err(no_match(params, run.iterations));
     }
     let n = ne.inliers as f64;
     Ok(Registration {
-        t_target_sensor: pose,
+        t_target_sensor: run.pose,
         converged,
-        iterations,
+        iterations: run.iterations,
         cost: Cost {
             total: ne.cost,
             mean: ne.cost / n,
@@ -95,9 +57,81 @@ pub(crate) fn run(
         mean_squared_distance_m2: ne.squared_distance / n,
         f_conv_m2: None,
         information: ne.hessian(),
-        last_increment: last,
+        last_increment: run.last,
         degenerate_directions: constrained.map_or(0, Constrained::dropped),
         weakest_lever_arm_m: constrained.map_or(f64::NAN, |c| c.weakest_lever_arm_m),
         geometric_information: constrained.map(|c| c.information),
     })
+}
+
+/// Where the Gauss-Newton loop stopped.
+struct Iterated {
+    /// The last iterate.
+    pose: Pose,
+    /// Increments applied.
+    iterations: usize,
+    /// The last increment.
+    last: Increment,
+    /// The full linearisation whose increment met the termination
+    /// thresholds (`None`: the iteration limit was reached).
+    final_ne: Option<NormalEquations>,
+}
+
+/// The error for an iterate without a single correspondence.
+fn no_match(params: &NdtParams, iteration: usize) -> RegistrationError {
+    RegistrationError::NoCorrespondences {
+        iteration,
+        max_distance_m: params.max_distance_m,
+    }
+}
+
+/// The increment `inc` is below the termination thresholds (Table 1)
+/// times `factor`.
+fn below(params: &NdtParams, inc: &Increment, factor: f64) -> bool {
+    inc.rotation_rad < params.termination_rotation_deg.to_radians() * factor
+        && inc.translation_m < params.termination_translation_m * factor
+}
+
+/// The Gauss-Newton iterations from `initial`: the coarse phase on every
+/// `coarse_stride`-th point, then every point until an increment is below
+/// the termination thresholds or `max_iterations` is reached.
+fn iterate(
+    initial: Pose,
+    params: &NdtParams,
+    constrained: Option<&Constrained>,
+    linearise: &mut impl FnMut(&Pose, usize) -> NormalEquations,
+) -> Result<Iterated, RegistrationError> {
+    let mut stride = params.coarse_stride.max(1);
+    let mut run = Iterated {
+        pose: initial,
+        iterations: 0,
+        last: Increment::default(),
+        final_ne: None,
+    };
+    for it in 0..params.max_iterations {
+        let mut ne = linearise(&run.pose, stride);
+        if ne.inliers < 6 && stride > 1 {
+            // Too sparse a subset: continue on every point.
+            stride = 1;
+            ne = linearise(&run.pose, stride);
+        }
+        if ne.inliers == 0 {
+            return Err(no_match(params, it));
+        }
+        let eps = match constrained {
+            Some(c) => ne.solve_in(&c.basis, it)?,
+            None => ne.solve(it)?,
+        };
+        run.pose = run.pose.oplus(&eps); // T ← ε ⊕ T, Eq. (5)
+        run.iterations = it + 1;
+        run.last = increment_of(&eps);
+        if stride == 1 && below(params, &run.last, 1.0) {
+            run.final_ne = Some(ne);
+            break;
+        }
+        if stride > 1 && below(params, &run.last, params.coarse_switch) {
+            stride = 1;
+        }
+    }
+    Ok(run)
 }
