@@ -468,7 +468,12 @@ fn report(
         several_hypotheses: count(&frames, |r| r.hypotheses_refined > 1),
         twins_refined: count(&frames, |r| r.twins.twins_refined > 0),
         twin_used: count(&frames, |r| r.twins.twin.is_some()),
-        mean_points: frames.iter().map(|r| r.points as f64).sum::<f64>() / n,
+        // An empty f64 sum is -0.0, which prints as "-0".
+        mean_points: if frames.is_empty() {
+            0.0
+        } else {
+            frames.iter().map(|r| r.points as f64).sum::<f64>() / n
+        },
         config,
         frames,
     }
@@ -550,8 +555,8 @@ fn fconv_stats(frames: &[CnnFrame], f_max_m2: f64) -> FconvStats {
     }
 }
 
-/// Success by range over 2.5-5, 5-10, 10-15 and 15-20 m (the last bin also
-/// holds the frames at 20 m or beyond).
+/// Success by range over 2.5-5, 5-10, 10-15 and 15-20 m (the first bin also
+/// holds the frames closer than 2.5 m, the last those at 20 m or beyond).
 fn range_bins(frames: &[CnnFrame]) -> Vec<RangeBin> {
     [2.5, 5.0, 10.0, 15.0, 20.0]
         .windows(2)
@@ -559,11 +564,12 @@ fn range_bins(frames: &[CnnFrame]) -> Vec<RangeBin> {
         .collect()
 }
 
-/// Success of the frames in [`lo`, `hi`) (unbounded above when `hi` ≥ 20 m).
+/// Success of the frames in [`lo`, `hi`) (unbounded below when `lo` ≤
+/// 2.5 m, above when `hi` ≥ 20 m).
 fn range_bin(frames: &[CnnFrame], lo: f64, hi: f64) -> RangeBin {
     let bin: Vec<&CnnFrame> = frames
         .iter()
-        .filter(|r| r.range_m >= lo && (r.range_m < hi || hi >= 20.0))
+        .filter(|r| (r.range_m >= lo || lo <= 2.5) && (r.range_m < hi || hi >= 20.0))
         .collect();
     let k = bin.len().max(1) as f64;
     RangeBin {
@@ -600,4 +606,47 @@ pub fn run(args: &EvalCnnArgs) -> Result<()> {
         println!("wrote {}", path.display());
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A frame at `range_m`, refined successfully when `success`.
+    fn frame_at(range_m: f64, success: bool) -> CnnFrame {
+        CnnFrame {
+            frame: 0,
+            range_m,
+            points: 1000,
+            rate_deg_s: 0.0,
+            scan_s: 0.1,
+            raw_err_deg: 1.0,
+            raw_err_cm: 1.0,
+            err_deg: 1.0,
+            err_cm: 1.0,
+            success_raw: success,
+            success_refined: success,
+            f_conv_m2: 1e-4,
+            accepted: true,
+            twins: spacepose_cnn::TwinOutcome::default(),
+            top_probability: 0.5,
+            hypothesis: 0,
+            hypotheses_refined: 1,
+            time_ms: spacepose_cnn::Timings::default(),
+            fconv_ms: 0.0,
+            error: None,
+        }
+    }
+
+    #[test]
+    fn every_frame_falls_in_one_range_bin() {
+        let ranges = [1.0, 2.5, 4.9, 5.0, 12.0, 19.9, 20.0, 30.0];
+        let frames: Vec<CnnFrame> = ranges.iter().map(|&r| frame_at(r, r < 10.0)).collect();
+        let bins = range_bins(&frames);
+        let counts: Vec<usize> = bins.iter().map(|b| b.frames).collect();
+        assert_eq!(counts, [3, 1, 1, 3]);
+        assert_eq!(bins.iter().map(|b| b.frames).sum::<usize>(), ranges.len());
+        assert_eq!(bins[0].success_rate_refined, 1.0);
+        assert_eq!(bins[3].success_rate_refined, 0.0);
+    }
 }
