@@ -12,7 +12,9 @@ use serde::{Deserialize, Serialize};
 pub enum WireStatus {
     /// Registration converged with good quality.
     Tracking = 0,
-    /// A pose was produced but its quality is doubtful (not fused).
+    /// The registration's quality is doubtful (not fused). The pose is the
+    /// tracker's filter prediction in `deblur` and `ct-ndt` modes, the
+    /// doubted registration in `ndt` and `icp` modes.
     Degraded = 1,
     /// The track is lost and must be re-acquired.
     Lost = 2,
