@@ -6,6 +6,7 @@
 //! missing one fails the test with the command that builds it.
 #![forbid(unsafe_code)]
 
+pub mod layout;
 pub mod net;
 
 use std::path::{Path, PathBuf};
