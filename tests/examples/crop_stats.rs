@@ -15,7 +15,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let names = Names::new(&args[1]).unwrap();
     let frames: usize = args[2].parse().unwrap();
-    let target = spacepose_target::Target::resolve("deos", 1.0).unwrap();
+    let target = spacepose_model::Target::resolve("deos", 1.0).unwrap();
     let bus = Bus::open(&names, "crop-stats").unwrap();
     let clouds = bus.cloud_subscriber(&names.cloud()).unwrap();
     let truths = bus.subscriber::<TruthMsg>(&names.truth()).unwrap();

@@ -41,10 +41,16 @@ fn main() -> Result<(), String> {
     for (n, f) in &big {
         println!("{n:5} lines: {f}");
     }
-    println!("{total_circles} import circles, {} production files over 400 lines", big.len());
+    println!(
+        "{total_circles} import circles, {} production files over 400 lines",
+        big.len()
+    );
     for id in meta.members_under(&root.join("services")) {
         let bus = |n: &str| {
-            n.starts_with("iceoryx2") || n.starts_with("zenoh") || n == "spacepose-bus" || n == "spacepose-messages"
+            n.starts_with("iceoryx2")
+                || n.starts_with("zenoh")
+                || n == "spacepose-bus"
+                || n == "spacepose-messages"
         };
         for path in forbidden_paths(&meta, id, false, bus).iter().take(1) {
             println!("{} reaches {}", meta.packages[id].name, path.join(" -> "));

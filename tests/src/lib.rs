@@ -9,21 +9,18 @@
 pub mod layout;
 pub mod net;
 
+use spacepose_messages::ServiceKind;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
 
-/// Every binary a full suite needs.
-pub const SUITE_BINARIES: [&str; 8] = [
-    "spacepose",
-    "spacepose-lidar-sim",
-    "spacepose-pcd-replay",
-    "spacepose-ingest",
-    "spacepose-tracker",
-    "spacepose-filter",
-    "spacepose-telemetry",
-    "spacepose-init",
-];
+/// Every binary a full suite needs: the CLI and one per service kind of
+/// the topic graph.
+pub fn suite_binaries() -> Vec<String> {
+    std::iter::once("spacepose".to_string())
+        .chain(ServiceKind::ALL.iter().map(|k| k.binary_name()))
+        .collect()
+}
 
 /// `target/release/` (the directory of the binaries), from the test
 /// executable's location (`target/release/deps/<test>`).
@@ -43,23 +40,17 @@ pub fn binary(name: &str) -> PathBuf {
     let path = bin_dir().join(name);
     assert!(
         path.is_file(),
-        "binary {name} is missing at {}: build it first with \
-         `CARGO_TARGET_DIR=<same target dir> cargo build --release -p {name}` \
-         (or build every suite binary: cargo build --release {})",
+        "binary {name} is missing at {}: build every binary first with \
+         `CARGO_TARGET_DIR=<same target dir> cargo build --release --workspace`",
         path.display(),
-        SUITE_BINARIES
-            .iter()
-            .map(|b| format!("-p {b}"))
-            .collect::<Vec<_>>()
-            .join(" ")
     );
     path
 }
 
 /// Checks that every suite binary exists (see [`binary`]).
 pub fn require_suite() -> PathBuf {
-    for b in SUITE_BINARIES {
-        binary(b);
+    for b in suite_binaries() {
+        binary(&b);
     }
     binary("spacepose")
 }

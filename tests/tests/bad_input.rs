@@ -121,7 +121,7 @@ fn bad_input_is_counted_and_the_next_frames_still_get_poses() {
         let Some(ingest) = w.latest.values().find(|h| h.service.as_str() == "ingest") else {
             return false;
         };
-        ingest.rejected_non_finite >= 1 && ingest.rejected_oversized >= 1
+        ingest.counters.rejected_non_finite >= 1 && ingest.counters.rejected_oversized >= 1
     });
     // Every frame after the injections still gets its pose, then all of them.
     w.wait_until("a pose for every frame", Duration::from_secs(90), |w| {
@@ -157,7 +157,7 @@ fn bad_input_is_counted_and_the_next_frames_still_get_poses() {
     let ingest = w.health_of("ingest");
     println!(
         "ingest: non-finite {} oversized {}; status:\n{status_text}",
-        ingest.rejected_non_finite, ingest.rejected_oversized
+        ingest.counters.rejected_non_finite, ingest.counters.rejected_oversized
     );
 
     let down = spacepose(&["down", "--prefix", &prefix]);
@@ -220,14 +220,14 @@ fn garbage_on_the_zenoh_command_key_is_counted_and_the_next_command_passes() {
             w.drain();
             std::thread::sleep(Duration::from_millis(20));
         }
-        let counted = w.health_of("telemetry").rejected_wire >= 1;
+        let counted = w.health_of("telemetry").counters.rejected_wire >= 1;
         if counted && w.commands_seen.iter().any(|c| c.sequence == 77) {
             break;
         }
         assert!(
             Instant::now() < deadline,
             "timed out: telemetry rejected_wire {}, commands {:?}",
-            w.health_of("telemetry").rejected_wire,
+            w.health_of("telemetry").counters.rejected_wire,
             w.commands_seen
                 .iter()
                 .map(|c| c.sequence)
@@ -255,6 +255,6 @@ fn garbage_on_the_zenoh_command_key_is_counted_and_the_next_command_passes() {
     assert!(!status_text.contains("no heartbeat"), "{status_text}");
     println!(
         "telemetry rejected_wire {}; status:\n{status_text}",
-        w.health_of("telemetry").rejected_wire
+        w.health_of("telemetry").counters.rejected_wire
     );
 }

@@ -324,7 +324,7 @@ fn ten_thousand_garbage_payloads_and_bad_clouds_are_refused_counted_and_survived
     }
     std::thread::sleep(Duration::from_millis(200));
     while commands.try_recv().unwrap().is_some() {}
-    let base = beats.of("telemetry").rejected_wire;
+    let base = beats.of("telemetry").counters.rejected_wire;
     assert_eq!(base, 0);
 
     let mut health_msg = Health::new(Name::new("x").unwrap(), Name::new("y").unwrap(), 1);
@@ -354,7 +354,7 @@ fn ten_thousand_garbage_payloads_and_bad_clouds_are_refused_counted_and_survived
     }
     let sent_s = started.elapsed().as_secs_f64();
     beats.wait("telemetry's rejected_wire", Duration::from_secs(30), |l| {
-        l["telemetry"].rejected_wire >= expected_rejected
+        l["telemetry"].counters.rejected_wire >= expected_rejected
     });
     std::thread::sleep(Duration::from_millis(300));
     beats.drain();
@@ -362,14 +362,14 @@ fn ten_thousand_garbage_payloads_and_bad_clouds_are_refused_counted_and_survived
         forwarded += 1;
     }
     let t = beats.of("telemetry");
-    assert_eq!(t.rejected_wire, expected_rejected);
+    assert_eq!(t.counters.rejected_wire, expected_rejected);
     assert_eq!(forwarded, expected_forwarded);
     assert_eq!(t.state, ServiceState::Running as u8);
     println!(
         "zenoh: {WIRE_CASES} payloads in {sent_s:.1} s: {expected_rejected} refused and counted \
          (rejected_wire {}), {expected_forwarded} bit flips still valid and forwarded ({warmup} \
          warm-up commands before)",
-        t.rejected_wire
+        t.counters.rejected_wire
     );
 
     // --- iceoryx2: bad raw clouds into ingest ------------------------------
@@ -393,7 +393,7 @@ fn ten_thousand_garbage_payloads_and_bad_clouds_are_refused_counted_and_survived
         // At most two frames in flight (the subscriber buffer): wait for
         // ingest's heartbeat (every 5 ms) to show the one before last.
         beats.wait("ingest to keep up", Duration::from_secs(30), |l| {
-            l["ingest"].frames_in + 1 >= before.frames_in + seq
+            l["ingest"].counters.frames_in + 1 >= before.counters.frames_in + seq
         });
         let (points, start_s, end_s, reason) = bad_cloud(&mut rng);
         let name = match reason {
@@ -420,31 +420,31 @@ fn ten_thousand_garbage_payloads_and_bad_clouds_are_refused_counted_and_survived
         }
     }
     beats.wait("ingest to take every frame", Duration::from_secs(30), |l| {
-        l["ingest"].frames_in >= before.frames_in + BAD_CLOUDS
+        l["ingest"].counters.frames_in >= before.counters.frames_in + BAD_CLOUDS
     });
     let clouds_s = started.elapsed().as_secs_f64();
     let i = beats.of("ingest");
     drain_cropped(&mut empty_out);
     let e = |k: &str| expected.get(k).copied().unwrap_or(0);
-    assert_eq!(i.frames_in - before.frames_in, BAD_CLOUDS);
+    assert_eq!(i.counters.frames_in - before.counters.frames_in, BAD_CLOUDS);
     // Empty clouds with a valid header: forwarded, each with its own header.
     assert!(e("empty") > 0);
     assert_eq!(
-        i.frames_out - before.frames_out,
+        i.counters.frames_out - before.counters.frames_out,
         e("empty"),
         "only the empty clouds come out"
     );
     assert_eq!(empty_out, empty_sent, "the empty clouds as sent");
-    assert_eq!(i.rejected_empty, before.rejected_empty);
+    assert_eq!(i.counters.rejected_empty, before.counters.rejected_empty);
     assert_eq!(
-        i.rejected_oversized - before.rejected_oversized,
+        i.counters.rejected_oversized - before.counters.rejected_oversized,
         e("oversized")
     );
     assert_eq!(
-        i.rejected_non_finite - before.rejected_non_finite,
+        i.counters.rejected_non_finite - before.counters.rejected_non_finite,
         e("non_finite")
     );
-    assert_eq!(i.errors - before.errors, e("errors"));
+    assert_eq!(i.counters.errors - before.counters.errors, e("errors"));
     assert_eq!(i.state, ServiceState::Running as u8);
     println!(
         "ingest: {BAD_CLOUDS} fuzzed clouds in {clouds_s:.1} s: {} empty ones with a valid header \
@@ -461,7 +461,7 @@ fn ten_thousand_garbage_payloads_and_bad_clouds_are_refused_counted_and_survived
     beats.wait(
         "a good frame through ingest",
         Duration::from_secs(10),
-        |l| l["ingest"].frames_out == before.frames_out + e("empty") + 1,
+        |l| l["ingest"].counters.frames_out == before.counters.frames_out + e("empty") + 1,
     );
     assert!(telemetry.0.try_wait().unwrap().is_none(), "telemetry died");
     assert!(ingest.0.try_wait().unwrap().is_none(), "ingest died");

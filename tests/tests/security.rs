@@ -229,12 +229,12 @@ fn only_operators_send_commands_and_readers_still_read_telemetry() {
         Duration::from_secs(10),
         || {
             telemetry_health(&health, &mut latest);
-            latest.filter(|h| h.rejected_wire >= 5)
+            latest.filter(|h| h.counters.rejected_wire >= 5)
         },
     );
     // Only the operator's 5 garbage payloads: the reader's and the anonymous
     // peer's commands never reached the bridge.
-    assert_eq!(counted.rejected_wire, 5);
+    assert_eq!(counted.counters.rejected_wire, 5);
     while let Some(c) = commands.try_recv().unwrap() {
         all.push(c);
     }
@@ -249,7 +249,7 @@ fn only_operators_send_commands_and_readers_still_read_telemetry() {
          anonymous peer: 25 commands each, 0 forwarded; rejected_wire {}",
         all.len(),
         sent,
-        counted.rejected_wire
+        counted.counters.rejected_wire
     );
     assert!(service.0.try_wait().unwrap().is_none(), "telemetry died");
 }

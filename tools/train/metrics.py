@@ -1,5 +1,5 @@
 """Validation monitors. The authoritative decode (Algorithm 1, Γ_sym) lives in Rust
-(services/cnn); here the attitude error uses the argmax class only, as a monitor."""
+(services/core/cnn); here the attitude error uses the argmax class only, as a monitor."""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """Train the seed 004 two-head CNN on a `spacepose dataset` directory and export it to ONNX.
 
     python tools/train/train.py --data /work/data/deos-train --val /work/data/deos-val \
-        --out services/cnn/models/deos --epochs 30 --threads 1 --max-minutes 70
+        --out services/core/cnn/models/deos --epochs 30 --threads 1 --max-minutes 70
 
 Writes <out>/model.onnx (contract: notes/acq-design.md), <out>/model.json (the dataset's
 meta.json + training metrics) and <out>/training-log.txt. See tools/train/README.md.

@@ -3,7 +3,7 @@
 use crate::codec::{CodecError, WireMessage, check_code, check_name, fixed_max_wire_bytes};
 use crate::convert::QUATERNION_NORM_TOLERANCE;
 use crate::error::MessageError;
-use crate::pose::WireMode;
+use crate::pose::TrackingMode;
 use crate::{Name, SCHEMA_VERSION};
 use iceoryx2::prelude::ZeroCopySend;
 use serde::{Deserialize, Serialize};
@@ -53,7 +53,7 @@ pub struct Command {
     pub schema: u16,
     /// [`CommandKind`] code.
     pub kind: u8,
-    /// [`WireMode`] code for [`CommandKind::Mode`].
+    /// [`TrackingMode::code`] for [`CommandKind::Mode`].
     pub mode: u8,
     /// Command counter of the issuer.
     pub sequence: u64,
@@ -98,7 +98,7 @@ impl WireMessage for Command {
     /// norm (within [`QUATERNION_NORM_TOLERANCE`]); all zero = no pose.
     fn validate(&self) -> Result<(), CodecError> {
         check_code("kind", self.kind, CommandKind::Swap as u8)?;
-        check_code("mode", self.mode, WireMode::MAX_CODE)?;
+        check_code("mode", self.mode, TrackingMode::MAX_CODE)?;
         check_name("target_instance", &self.target_instance)?;
         check_name("issued_by", &self.issued_by)?;
         let q = &self.q_sensor_target;

@@ -30,6 +30,15 @@ pub enum MessageError {
         /// Norm of the received quaternion.
         norm: f64,
     },
+    /// A message whose values cannot be what they claim (a time or a
+    /// covariance that is not finite, ...).
+    #[error("invalid {what}: {reason}")]
+    InvalidMessage {
+        /// Which message.
+        what: &'static str,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// An enumeration stored as `u8` has a value that names no variant.
     #[error("unknown {what} code {code}")]
     UnknownCode {

@@ -46,6 +46,43 @@ impl ServiceState {
     }
 }
 
+/// Counters of one service since it started (frames unless said
+/// otherwise): the one declaration, carried in [`Health`], kept by the
+/// runtime and shown in telemetry.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend, Serialize, Deserialize)]
+#[type_name("spacepose::Counters")]
+pub struct Counters {
+    /// Frames (or messages) received.
+    pub frames_in: u64,
+    /// Frames (or messages) published.
+    pub frames_out: u64,
+    /// Frames that held NaN or infinite points.
+    pub rejected_non_finite: u64,
+    /// Empty frames rejected.
+    pub rejected_empty: u64,
+    /// Frames above capacity rejected.
+    pub rejected_oversized: u64,
+    /// Wire payloads rejected by the codec (garbage on a zenoh key, a
+    /// message a service refused).
+    pub rejected_wire: u64,
+    /// Other errors (processing, bus, files).
+    pub errors: u64,
+    /// Sequence of the last frame processed.
+    pub last_frame: u64,
+}
+
+impl Counters {
+    /// Frames (or payloads) rejected for any reason: non-finite points,
+    /// empty, oversized, refused by the codec.
+    pub fn rejected(&self) -> u64 {
+        self.rejected_non_finite
+            + self.rejected_empty
+            + self.rejected_oversized
+            + self.rejected_wire
+    }
+}
+
 /// Heartbeat and counters of one service instance.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
@@ -63,24 +100,10 @@ pub struct Health {
     pub service: Name,
     /// Heartbeat counter (starts at 0).
     pub sequence: u64,
-    /// Sequence of the last frame processed.
-    pub last_frame: u64,
     /// Time since the service started (s).
     pub uptime_s: f64,
-    /// Frames (or messages) received.
-    pub frames_in: u64,
-    /// Frames (or messages) published.
-    pub frames_out: u64,
-    /// Frames rejected because they held NaN/infinite points.
-    pub rejected_non_finite: u64,
-    /// Frames rejected because they were empty.
-    pub rejected_empty: u64,
-    /// Frames rejected because they exceeded the cloud capacity.
-    pub rejected_oversized: u64,
-    /// Wire payloads rejected by the codec (garbage on a zenoh key).
-    pub rejected_wire: u64,
-    /// Other errors (registration failures, bus errors).
-    pub errors: u64,
+    /// What the service counted since it started.
+    pub counters: Counters,
     /// CLOCK_REALTIME at send (ns since the Unix epoch).
     pub published_ns: i64,
 }

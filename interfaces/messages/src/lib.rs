@@ -17,7 +17,9 @@ pub mod command;
 pub mod convert;
 pub mod error;
 pub mod filter;
+pub mod graph;
 pub mod health;
+pub mod message;
 pub mod name;
 pub mod names;
 pub mod pose;
@@ -31,14 +33,16 @@ pub use codec::{WireMessage, decode, encode};
 pub use command::{Command, CommandKind};
 pub use error::{CodecError, MessageError};
 pub use filter::FilterState;
-pub use health::{Health, ServiceState};
+pub use graph::{Need, ServiceKind};
+pub use health::{Counters, Health, ServiceState};
+pub use message::{Cloud, Message};
 pub use name::Name;
 pub use names::{Names, Topic};
-pub use pose::{PoseEstimate, WireMode, WireStatus};
+pub use pose::{PoseEstimate, TrackingMode, WireStatus, mode_from_code};
 pub use truth::TruthMsg;
 
 /// Re-export of the derive and trait needed to define further payload types.
 pub use iceoryx2::prelude::ZeroCopySend;
 
 /// Version of the wire schema (the codec envelope and every `schema` field).
-pub const SCHEMA_VERSION: u16 = 1;
+pub const SCHEMA_VERSION: u16 = 2;

@@ -5,6 +5,7 @@ use crate::error::MessageError;
 use crate::{Name, SCHEMA_VERSION};
 use iceoryx2::prelude::ZeroCopySend;
 use serde::{Deserialize, Serialize};
+pub use spacepose_tracker::TrackingMode;
 
 /// Track status on the wire (stored as `u8` in [`PoseEstimate::status`]).
 #[repr(u8)]
@@ -44,57 +45,10 @@ impl WireStatus {
     }
 }
 
-/// Tracking mode on the wire (stored as `u8` in [`PoseEstimate::mode`] and
-/// [`crate::Command::mode`]); the names match the tracker's `TrackingMode`.
-#[repr(u8)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum WireMode {
-    /// Smoothed NDT seeded by the previous pose.
-    Ndt = 0,
-    /// Smoothed NDT on a motion-compensated cloud, seeded by the filter.
-    Deblur = 1,
-    /// Continuous-time NDT seeded by the filter.
-    CtNdt = 2,
-    /// Point-to-point ICP seeded by the previous pose.
-    Icp = 3,
-}
-
-impl WireMode {
-    /// Largest valid code.
-    pub const MAX_CODE: u8 = 3;
-
-    /// Decodes the `u8` code.
-    pub fn from_u8(code: u8) -> Result<WireMode, MessageError> {
-        match code {
-            0 => Ok(WireMode::Ndt),
-            1 => Ok(WireMode::Deblur),
-            2 => Ok(WireMode::CtNdt),
-            3 => Ok(WireMode::Icp),
-            _ => Err(MessageError::UnknownCode { what: "mode", code }),
-        }
-    }
-
-    /// The tracker's config name (`"ndt"`, `"deblur"`, `"ct-ndt"`, `"icp"`).
-    pub fn as_str(self) -> &'static str {
-        match self {
-            WireMode::Ndt => "ndt",
-            WireMode::Deblur => "deblur",
-            WireMode::CtNdt => "ct-ndt",
-            WireMode::Icp => "icp",
-        }
-    }
-
-    /// Parses [`WireMode::as_str`].
-    pub fn parse(s: &str) -> Option<WireMode> {
-        [
-            WireMode::Ndt,
-            WireMode::Deblur,
-            WireMode::CtNdt,
-            WireMode::Icp,
-        ]
-        .into_iter()
-        .find(|m| m.as_str() == s)
-    }
+/// The tracking mode of an estimate or a command, from its code (the
+/// tracker's one [`TrackingMode`]).
+pub fn mode_from_code(code: u8) -> Result<TrackingMode, MessageError> {
+    TrackingMode::from_code(code).ok_or(MessageError::UnknownCode { what: "mode", code })
 }
 
 /// One pose estimate of `t_sensor_target` (target body frame -> sensor frame).
@@ -106,7 +60,7 @@ pub struct PoseEstimate {
     pub schema: u16,
     /// [`WireStatus`] code.
     pub status: u8,
-    /// [`WireMode`] code of the registration that produced the pose.
+    /// [`TrackingMode::code`] of the registration that produced the pose.
     pub mode: u8,
     /// Registration iterations used.
     pub iterations: u32,
@@ -167,7 +121,7 @@ impl WireMessage for PoseEstimate {
 
     fn validate(&self) -> Result<(), CodecError> {
         check_code("status", self.status, WireStatus::Lost as u8)?;
-        check_code("mode", self.mode, WireMode::MAX_CODE)?;
+        check_code("mode", self.mode, TrackingMode::MAX_CODE)?;
         check_name("instance", &self.instance)
     }
 

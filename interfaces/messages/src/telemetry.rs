@@ -12,8 +12,8 @@
 use crate::clock::elapsed_ms;
 use crate::convert::rotation_from_wxyz;
 use crate::error::MessageError;
-use crate::health::ServiceState;
-use crate::pose::{WireMode, WireStatus};
+use crate::health::{Counters, ServiceState};
+use crate::pose::{WireStatus, mode_from_code};
 use crate::{FilterState, Health, PoseEstimate, TruthMsg};
 use serde::{Deserialize, Serialize};
 use spacepose_geometry::Euler321;
@@ -97,7 +97,7 @@ impl TelemetryPose {
             sequence: m.sequence,
             t_s: m.t_s,
             status: WireStatus::from_u8(m.status)?.as_str().to_string(),
-            mode: WireMode::from_u8(m.mode)?.as_str().to_string(),
+            mode: mode_from_code(m.mode)?.as_str().to_string(),
             q_sensor_target: m.q_sensor_target,
             p_sensor_target_m: m.p_sensor_target,
             euler_321_deg: euler_deg(&m.q_sensor_target)?,
@@ -192,24 +192,13 @@ pub struct TelemetryHealth {
     pub pid: u32,
     /// Heartbeat counter.
     pub sequence: u64,
-    /// Sequence of the last frame processed.
-    pub last_frame: u64,
     /// Time since the service started (s).
     pub uptime_s: f64,
-    /// Frames (messages) received.
-    pub frames_in: u64,
-    /// Frames (messages) published.
-    pub frames_out: u64,
-    /// Frames rejected for NaN/infinite points.
-    pub rejected_non_finite: u64,
-    /// Empty frames rejected.
-    pub rejected_empty: u64,
-    /// Frames rejected for exceeding the cloud capacity.
-    pub rejected_oversized: u64,
-    /// Wire payloads rejected by the codec.
-    pub rejected_wire: u64,
-    /// Other errors.
-    pub errors: u64,
+    /// The service's counters (`frames_in`, `frames_out`,
+    /// `rejected_non_finite`, `rejected_empty`, `rejected_oversized`,
+    /// `rejected_wire`, `errors`, `last_frame`), as top-level keys.
+    #[serde(flatten)]
+    pub counters: Counters,
     /// CLOCK_REALTIME of the heartbeat (ns).
     pub published_ns: i64,
 }
@@ -224,15 +213,8 @@ impl TelemetryHealth {
             state: ServiceState::from_u8(m.state)?.as_str().to_string(),
             pid: m.pid,
             sequence: m.sequence,
-            last_frame: m.last_frame,
             uptime_s: m.uptime_s,
-            frames_in: m.frames_in,
-            frames_out: m.frames_out,
-            rejected_non_finite: m.rejected_non_finite,
-            rejected_empty: m.rejected_empty,
-            rejected_oversized: m.rejected_oversized,
-            rejected_wire: m.rejected_wire,
-            errors: m.errors,
+            counters: m.counters,
             published_ns: m.published_ns,
         })
     }
@@ -317,7 +299,7 @@ impl TelemetryErrors {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Name;
+    use crate::{Name, TrackingMode};
     use nalgebra::Vector3;
     use spacepose_geometry::{Pose, so3};
 
@@ -325,7 +307,7 @@ mod tests {
         let mut m = PoseEstimate::new();
         m.instance = Name::new("tracker-a").unwrap();
         m.status = WireStatus::Degraded as u8;
-        m.mode = WireMode::CtNdt as u8;
+        m.mode = TrackingMode::CtNdt.code();
         m.set_pose(&Pose::new(
             Euler321::from_degrees(10.0, 20.0, 30.0).to_rotation(),
             Vector3::new(0.1, 0.2, 20.0),

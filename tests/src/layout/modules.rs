@@ -161,7 +161,13 @@ struct Walker {
 impl Walker {
     /// Reads `file` as module `path`; `mod_rs`: its children live in its
     /// own directory (lib.rs, main.rs, mod.rs, or a `#[path]` file).
-    fn file(&mut self, file: &Path, path: Vec<String>, test: bool, mod_rs: bool) -> Result<(), String> {
+    fn file(
+        &mut self,
+        file: &Path,
+        path: Vec<String>,
+        test: bool,
+        mod_rs: bool,
+    ) -> Result<(), String> {
         let text = std::fs::read_to_string(file).map_err(|e| format!("{}: {e}", file.display()))?;
         let ast = syn::parse_file(&text).map_err(|e| format!("{}: {e}", file.display()))?;
         let index = self.files.len();
@@ -287,7 +293,11 @@ impl Walker {
                     rest = &rest[1..];
                 }
             }
-            Some(first) if self.modules.get(at).is_some_and(|m| m.children.contains(first)) => {}
+            Some(first)
+                if self
+                    .modules
+                    .get(at)
+                    .is_some_and(|m| m.children.contains(first)) => {}
             _ => return None,
         }
         self.walk(cur, rest, depth)
@@ -324,7 +334,11 @@ impl Walker {
 }
 
 /// `(binding, path)` of every leaf of a use tree; `None` for a glob.
-fn flatten_use(tree: &syn::UseTree, prefix: Vec<String>, out: &mut Vec<(Option<String>, Vec<String>)>) {
+fn flatten_use(
+    tree: &syn::UseTree,
+    prefix: Vec<String>,
+    out: &mut Vec<(Option<String>, Vec<String>)>,
+) {
     match tree {
         syn::UseTree::Path(p) => {
             let mut next = prefix;
@@ -419,9 +433,12 @@ fn item_name(item: &syn::Item) -> Option<String> {
 fn is_test(attrs: &[syn::Attribute]) -> bool {
     attrs.iter().any(|a| {
         a.path().is_ident("cfg")
-            && a.meta
-                .require_list()
-                .is_ok_and(|l| l.tokens.to_string().split(|c: char| !c.is_alphanumeric() && c != '_').any(|w| w == "test"))
+            && a.meta.require_list().is_ok_and(|l| {
+                l.tokens
+                    .to_string()
+                    .split(|c: char| !c.is_alphanumeric() && c != '_')
+                    .any(|w| w == "test")
+            })
     })
 }
 

@@ -1,0 +1,36 @@
+//! Relative-motion filter of the spacepose tracker (seed 000 §3.2).
+//!
+//! - [`position`]: linear Kalman filter on `[p; v]`, constant velocity
+//!   (Eq. 8, 10).
+//! - [`attitude`]: invariant EKF on `(R, ω)`, constant angular velocity
+//!   (Eq. 9, 11), derivation in its module docs.
+//! - [`filter`]: [`RelativeMotionFilter`], both filters behind one clock, with
+//!   prediction at any time, measurement noise from the registration's
+//!   information matrix and a Mahalanobis innovation gate.
+//! - [`motion_compensation`]: un-blurring of a scan with the predicted motion
+//!   (Eq. 12).
+//! - [`wire`]: conversions to and from the suite's messages (`FilterState`,
+//!   `PoseEstimate`, `AcquisitionResult`); [`selector`]: one estimate per
+//!   frame (primary/standby with a per-frame deadline), with sticky
+//!   [`failover`] (promotion of the standby, revert); [`service`]: the logic of the `spacepose-filter` binary, bus-free;
+//!   [`snapshot`]: the state persisted for a restarted filter service.
+//!
+//! Units SI. `R = r_sensor_target` (target body → sensor), `p = p_sensor` the
+//! target origin in the sensor frame, `v_sensor = dp/dt` in the sensor frame,
+//! `w_target` the target's angular velocity in the target frame.
+#![forbid(unsafe_code)]
+
+pub mod attitude;
+pub mod config;
+pub mod error;
+pub mod filter;
+pub mod kalman;
+pub mod motion_compensation;
+pub mod position;
+
+pub use attitude::AttitudeFilter;
+pub use config::FilterConfig;
+pub use error::FilterError;
+pub use filter::{Prediction, RelativeMotionFilter, UpdateOutcome, covariance_from_information};
+pub use motion_compensation::MotionCompensation;
+pub use position::PositionFilter;

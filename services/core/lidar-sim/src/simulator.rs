@@ -1,0 +1,246 @@
+//! The lidar simulator: one frame = one scan of the pattern over the
+//! integration window, each ray traced against the moving target (and the
+//! facility background), then detection, outliers and noise.
+
+use crate::config::{SensorConfig, SurfaceModel};
+use crate::detection::DetectionModel;
+use crate::error::SimError;
+use crate::measurement::Measurement;
+use crate::pattern::Scan;
+use crate::scene::{FrameScene, TargetMotion};
+use crate::surface::{Surface, draw_surfaces, validate_materials};
+use nalgebra::Vector3;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use spacepose_geometry::Point;
+use spacepose_model::Target;
+use spacepose_scenario::TruthState;
+use std::sync::Arc;
+
+/// Reported intensity = received return factor (m⁻²) × this reference area:
+/// a white Lambertian surface at normal incidence 10 m away reads 1.
+pub const INTENSITY_REFERENCE_M2: f64 = 100.0;
+
+/// What produced a point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ReturnKind {
+    /// An echo of the target (possibly mixed by divergence or reflections).
+    Target,
+    /// An echo of the test-facility background (`Effects::clutter`).
+    Clutter,
+    /// A point drawn as an outlier (range σ = 4 σ_RANGE, seed 002).
+    Outlier,
+}
+
+/// One simulated scan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    /// Points in the sensor frame, in scan (time) order.
+    pub points: Vec<Point>,
+    /// What produced each point (same length and order as `points`).
+    pub kinds: Vec<ReturnKind>,
+    /// Start of the scan window (s): `scan_end - integration_time`.
+    pub scan_start: f64,
+    /// End of the scan window (s), the time of `truth`.
+    pub scan_end: f64,
+    /// Ground truth at scan end.
+    pub truth: TruthState,
+}
+
+/// High-fidelity lidar simulator for one target and one sensor.
+#[derive(Debug, Clone)]
+pub struct LidarSimulator {
+    target: Arc<Target>,
+    config: SensorConfig,
+    detection: DetectionModel,
+}
+
+impl LidarSimulator {
+    /// A simulator after validating the configuration and the target's materials.
+    pub fn new(target: Arc<Target>, config: SensorConfig) -> Result<Self, SimError> {
+        config.validate()?;
+        validate_materials(target.name(), target.materials())?;
+        let n = target.materials().len();
+        if let Some(&bad) = target
+            .mesh()
+            .face_materials()
+            .iter()
+            .find(|&&m| usize::from(m) >= n)
+        {
+            return Err(SimError::BadMaterial {
+                target: target.name().to_owned(),
+                materials: n,
+                reason: if bad == u16::MAX {
+                    "face material u16::MAX"
+                } else {
+                    "a face refers to an undefined material"
+                },
+            });
+        }
+        let detection = config.detection.model();
+        Ok(LidarSimulator {
+            target,
+            config,
+            detection,
+        })
+    }
+
+    /// The sensor configuration.
+    pub fn config(&self) -> &SensorConfig {
+        &self.config
+    }
+
+    /// The simulated target.
+    pub fn target(&self) -> &Arc<Target> {
+        &self.target
+    }
+
+    /// The surfaces of one frame, indexed by material. The Phong draws are
+    /// made under both models so that the rest of the frame's random stream
+    /// (noise, outliers, detection) does not depend on the surface model.
+    fn frame_surfaces(&self, rng: &mut ChaCha8Rng) -> Vec<Surface> {
+        let drawn = draw_surfaces(self.target.materials(), rng);
+        match self.config.surface_model {
+            SurfaceModel::Phong => drawn,
+            SurfaceModel::Lambertian => drawn
+                .iter()
+                .map(|s| Surface::lambertian(s.reflectance))
+                .collect(),
+        }
+    }
+
+    /// An independent, reproducible random stream for frame `frame_index` of
+    /// a run seeded with `seed` (ChaCha8, one stream per frame).
+    pub fn frame_rng(seed: u64, frame_index: u64) -> ChaCha8Rng {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        rng.set_stream(frame_index);
+        rng
+    }
+
+    /// Simulates one scan over `[scan_end - integration_time, scan_end]`,
+    /// `scan_end = truth.t`; the target moves with the constant velocity and
+    /// angular velocity of `truth` (taken at scan end) during the scan.
+    ///
+    /// A truth state holding NaN or infinity yields an empty frame; use
+    /// [`LidarSimulator::try_simulate`] to get the error instead.
+    pub fn simulate(&self, truth: &TruthState, rng: &mut ChaCha8Rng) -> Frame {
+        self.try_simulate(truth, rng).unwrap_or_else(|_| Frame {
+            points: Vec::new(),
+            kinds: Vec::new(),
+            scan_start: truth.t - self.config.integration_time_s,
+            scan_end: truth.t,
+            truth: *truth,
+        })
+    }
+
+    /// [`LidarSimulator::simulate`], with an error for a non-finite truth state.
+    pub fn try_simulate(
+        &self,
+        truth: &TruthState,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Frame, SimError> {
+        if !truth_is_finite(truth) {
+            return Err(SimError::NonFiniteTruth(truth.t));
+        }
+        let c = &self.config;
+        // Per-frame draws: scan phase, then material properties (seed 004 §IV.B).
+        let scan = c
+            .pattern
+            .scan(truth.t, c.integration_time_s, c.points_per_second, rng);
+        let scene = self.frame_scene(truth, rng);
+        let (points, kinds) = self.measure_scan(&scan, &scene, rng);
+        Ok(Frame {
+            points,
+            kinds,
+            scan_start: scan.scan_start(),
+            scan_end: truth.t,
+            truth: *truth,
+        })
+    }
+
+    /// The scene of the frame ending at `truth.t`: the target moving with
+    /// `truth`'s velocities, this frame's surface draws (the only random
+    /// draws here), the facility background if `Effects::clutter`, and the
+    /// beam (divergence, reflections) as the effects ask.
+    fn frame_scene(&self, truth: &TruthState, rng: &mut ChaCha8Rng) -> FrameScene<'_> {
+        let c = &self.config;
+        let fx = c.effects;
+        FrameScene {
+            target: &self.target,
+            motion: scan_motion(truth, fx.motion_blur),
+            surfaces: self.frame_surfaces(rng),
+            clutter: if fx.clutter {
+                c.facility.build(&self.target, &truth.t_sensor_target)
+            } else {
+                Vec::new()
+            },
+            clutter_surface: Surface::lambertian(c.facility.reflectance),
+            bounding_radius: self.target.bounding_radius(),
+            beta: if fx.beam_divergence {
+                c.beam_divergence_deg.to_radians()
+            } else {
+                0.0
+            },
+            rays_per_beam: if fx.beam_divergence {
+                c.divergent_rays
+            } else {
+                1
+            },
+            reflections: fx.reflections,
+            max_range: c.max_range_m,
+            reflection_offset_m: 1e-4 * self.target.bounding_radius() + 1e-6,
+        }
+    }
+
+    /// Every ray of `scan` traced through `scene` and measured, in scan
+    /// order: the detected points and what produced each.
+    fn measure_scan(
+        &self,
+        scan: &Scan,
+        scene: &FrameScene<'_>,
+        rng: &mut ChaCha8Rng,
+    ) -> (Vec<Point>, Vec<ReturnKind>) {
+        let measurement = Measurement::new(&self.config, &self.detection);
+        let mut points = Vec::with_capacity(scan.len() / 2);
+        let mut kinds = Vec::with_capacity(scan.len() / 2);
+        for (t, dir) in scan.rays() {
+            let Some(echo) = scene.trace_beam(t, &dir, rng) else {
+                continue;
+            };
+            if let Some((point, kind)) = measurement.measure(t, &dir, &echo, rng) {
+                points.push(point);
+                kinds.push(kind);
+            }
+        }
+        (points, kinds)
+    }
+}
+
+/// The target's motion during the scan ending at `truth.t`: `truth`'s pose
+/// extrapolated backwards with its constant velocity (seed 000 Eq. 8) and
+/// angular velocity (Eq. 9) when `blur`, else held at the scan-end pose.
+fn scan_motion(truth: &TruthState, blur: bool) -> TargetMotion {
+    TargetMotion {
+        r_sensor_target: truth.t_sensor_target.rotation,
+        t_sensor_target: truth.t_sensor_target.translation,
+        v_sensor: truth.v_sensor_target,
+        w_target: truth.w_target,
+        t_end: truth.t,
+        blur,
+    }
+}
+
+/// Whether every field of `truth` (time, pose, velocities) is finite.
+fn truth_is_finite(truth: &TruthState) -> bool {
+    let finite = |v: &Vector3<f64>| v.iter().all(|x| x.is_finite());
+    truth.t.is_finite()
+        && finite(&truth.t_sensor_target.translation)
+        && truth
+            .t_sensor_target
+            .rotation
+            .matrix()
+            .iter()
+            .all(|x| x.is_finite())
+        && finite(&truth.v_sensor_target)
+        && finite(&truth.w_target)
+}

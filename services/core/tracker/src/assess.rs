@@ -1,0 +1,109 @@
+//! Assessment of one registration: the reasons to doubt it on its own
+//! figures and against the prediction, and what is published for it.
+//! Loss is reported, never hidden: a doubted frame is `degraded` and not
+//! fused; too many in a row make the track `lost` (`crate::Tracker`).
+
+use crate::config::{LossConfig, TrackerConfig};
+use crate::dispatch::{attitude_scaling, ct_attitude_scale};
+use crate::mode::TrackingMode;
+use crate::status::TrackStatus;
+use nalgebra::Matrix6;
+use spacepose_filter::Prediction;
+use spacepose_geometry::Pose;
+use spacepose_registration::Registration;
+
+/// A registration that stopped at its iteration limit while still moving
+/// by more than `loss.max_final_increment_*`.
+pub(crate) fn stalled(l: &LossConfig, r: &Registration) -> bool {
+    !r.converged
+        && (r.last_increment.rotation_rad.to_degrees() > l.max_final_increment_deg
+            || r.last_increment.translation_m > l.max_final_increment_m)
+}
+
+/// Reasons to doubt a registration on its own figures.
+pub(crate) fn quality_issues(c: &TrackerConfig, r: &Registration) -> Vec<String> {
+    let l = &c.loss;
+    let mut reasons = Vec::new();
+    if r.inliers < l.min_inliers || r.inlier_fraction() < l.min_inlier_fraction {
+        reasons.push(format!(
+            "{} inliers ({:.0}%)",
+            r.inliers,
+            100.0 * r.inlier_fraction()
+        ));
+    }
+    let max_cost = if c.mode == TrackingMode::Icp {
+        l.max_mean_cost_icp_m2
+    } else {
+        l.max_mean_cost_ndt
+    };
+    if r.cost.mean.is_nan() || r.cost.mean > max_cost {
+        reasons.push(format!(
+            "mean cost {:.3e} above {max_cost:.3e}",
+            r.cost.mean
+        ));
+    }
+    if stalled(l, r) {
+        reasons.push(format!(
+            "no convergence after {} iterations (last step {:.2} deg, {:.3} m)",
+            r.iterations,
+            r.last_increment.rotation_rad.to_degrees(),
+            r.last_increment.translation_m
+        ));
+    }
+    reasons
+}
+
+/// The reason to doubt a measurement that jumps from the prediction by
+/// more than `loss.max_innovation_*`.
+pub(crate) fn inconsistency(
+    l: &LossConfig,
+    innovation_rot_deg: f64,
+    innovation_pos_m: f64,
+) -> Option<String> {
+    (innovation_rot_deg > l.max_innovation_rot_deg || innovation_pos_m > l.max_innovation_pos_m)
+        .then(|| {
+            format!(
+                "inconsistent with prediction ({innovation_rot_deg:.1} deg, {innovation_pos_m:.3} m)"
+            )
+        })
+}
+
+/// The measurement covariance `[rot; trans]` with its attitude inflated by
+/// `ct_ndt_attitude_covariance_scale` in `ct-ndt` mode (`D C D`,
+/// `D = diag(√s I, I)`), unless the cloud was `compensated`: a sparse
+/// `ct-ndt` frame fitted as one pose is fused as `deblur` fuses it, since
+/// the inflation is for CT-NDT's extrapolated end pose (with it, the filter
+/// lost seed 1's tumble in a sparse stretch, its rate hardly corrected).
+pub(crate) fn attitude_scaled(
+    c: &TrackerConfig,
+    covariance: Matrix6<f64>,
+    compensated: bool,
+) -> Matrix6<f64> {
+    if compensated {
+        return covariance;
+    }
+    let d = attitude_scaling(ct_attitude_scale(c));
+    d * covariance * d
+}
+
+/// The pose (and its covariance) the tracker publishes for a frame: the
+/// measurement, unless it was doubted (not fused) in a mode whose estimator
+/// is the filter (`deblur`, `ct-ndt`: its prediction seeds every frame).
+/// There the filter's prediction stands, as it does for a frame without a
+/// measurement: a rejected measurement is not the estimate (tumbling seed
+/// 13, frame 84: a stalled fit 3.70° off, the prediction 0.58°). In `ndt`
+/// and `icp` modes (Fig. 2) the registration is the estimate and the next
+/// guess, so a doubted one is published as it is, flagged by the status.
+pub(crate) fn published(
+    mode: TrackingMode,
+    status: TrackStatus,
+    measured: Pose,
+    covariance: Option<Matrix6<f64>>,
+    prediction: &Prediction,
+) -> (Pose, Option<Matrix6<f64>>) {
+    if status == TrackStatus::Tracking || !mode.uses_prediction() {
+        (measured, covariance)
+    } else {
+        (prediction.pose, Some(prediction.covariance))
+    }
+}

@@ -1,0 +1,239 @@
+//! Mode dispatch: which registration each mode runs, from which guess
+//! (seed 000 Fig. 2-4), with the degeneracy handling's threshold in force.
+
+use crate::config::{CtStart, TrackerConfig};
+use crate::error::TrackError;
+use crate::held_rotation::held_at;
+use crate::measurement::inversion_jacobian;
+use crate::mode::TrackingMode;
+use crate::model::TrackingModel;
+use nalgebra::{Matrix3, Matrix6, Vector6};
+use spacepose_filter::{Prediction, RelativeMotionFilter};
+use spacepose_geometry::{Point, Pose};
+use spacepose_registration::{
+    CtPriors, DisplacementPrior, NdtParams, RatePrior, Registration, ScanTimes, StartPrior,
+    hold_weak_rotations, register_ct_ndt, register_ct_ndt_with_priors, register_icp, register_ndt,
+};
+
+/// The last pose the tracker produced.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LastPose {
+    pub(crate) t: f64,
+    pub(crate) t_sensor_target: Pose,
+}
+
+/// `diag(√s I₃, I₃)`: scales the attitude block of a `[rot; trans]`
+/// covariance by `s` and the cross blocks by `√s`.
+pub(crate) fn attitude_scaling(s: f64) -> Matrix6<f64> {
+    let r = s.sqrt();
+    Matrix6::from_diagonal(&Vector6::new(r, r, r, 1.0, 1.0, 1.0))
+}
+
+/// `TrackerConfig::ct_ndt_attitude_covariance_scale` in `ct-ndt` mode, 1
+/// otherwise.
+pub(crate) fn ct_attitude_scale(c: &TrackerConfig) -> f64 {
+    match c.mode {
+        TrackingMode::CtNdt => c.ct_ndt_attitude_covariance_scale,
+        _ => 1.0,
+    }
+}
+
+/// The NDT parameters in force. Hysteresis of the degeneracy handling:
+/// while a rotation is held (`holding`), it is released only above
+/// `release_lever_arm_m`; while the hold follows a fitted rate
+/// (`following_min_lever_arm_m`), only where the frame would count in the
+/// fit.
+pub(crate) fn ndt_params(
+    c: &TrackerConfig,
+    holding: bool,
+    following_min_lever_arm_m: Option<f64>,
+) -> NdtParams {
+    let base = NdtParams {
+        min_lever_arm_m: c.min_lever_arm_m(),
+        ..c.ndt
+    };
+    if !holding || base.min_lever_arm_m <= 0.0 {
+        return base;
+    }
+    let mut release = c.release_lever_arm_m.max(base.min_lever_arm_m);
+    if let Some(fit) = following_min_lever_arm_m {
+        release = release.max(fit);
+    }
+    NdtParams {
+        min_lever_arm_m: release,
+        ..base
+    }
+}
+
+/// What one frame's registration needs from the tracker.
+pub(crate) struct Dispatch<'a> {
+    pub(crate) config: &'a TrackerConfig,
+    pub(crate) model: &'a TrackingModel,
+    pub(crate) filter: &'a RelativeMotionFilter,
+    /// From [`ndt_params`].
+    pub(crate) ndt: NdtParams,
+}
+
+impl Dispatch<'_> {
+    /// Runs the registration of the current mode from its initial guess;
+    /// `compensated` as the frame pipeline returned it.
+    pub(crate) fn register(
+        &self,
+        cloud: &[Point],
+        compensated: bool,
+        prediction: &Prediction,
+        last: &LastPose,
+        scan: &ScanTimes,
+    ) -> Result<Registration, TrackError> {
+        let previous = last.t_sensor_target.inverse();
+        let predicted = prediction.pose.inverse();
+        let (map, c, ndt) = (&self.model.map, self.config, &self.ndt);
+        Ok(match c.mode {
+            // A held rotation is moved from the guess (the previous pose)
+            // to the prediction, as in `icp` mode: where no rate has been
+            // fitted it would otherwise stand still.
+            TrackingMode::Ndt => held_at(register_ndt(map, cloud, &previous, ndt)?, &predicted),
+            // ICP holds a rotation the surface leaves free without saying
+            // so. It is held at the prediction instead, as `deblur` holds
+            // it, and reported as NDT reports it, so that the hold follows
+            // the fitted rate (`follow_held_rate`) when there is one. At
+            // the previous pose it stood still without a fit (slow-spin
+            // seed 7: from frame 1320 at 4.5 m, 1°/s, lost).
+            TrackingMode::Icp => {
+                let r = register_icp(self.model.icp()?, cloud, &previous, &c.icp)?;
+                hold_weak_rotations(map, cloud, &predicted, r, ndt)
+            }
+            TrackingMode::Deblur => register_ndt(map, cloud, &predicted, ndt)?,
+            // A sparse frame, compensated by the prediction: one pose.
+            TrackingMode::CtNdt if compensated => register_ndt(map, cloud, &predicted, ndt)?,
+            TrackingMode::CtNdt => match c.ct_start {
+                CtStart::Fixed => {
+                    let start = self.fixed_ct_start(last, scan.start_s)?;
+                    register_ct_ndt(map, cloud, scan, &start, &predicted, ndt)?
+                }
+                CtStart::FilterPrior => {
+                    let priors = self.ct_priors(prediction, scan)?;
+                    register_ct_ndt_with_priors(map, cloud, scan, &priors, &predicted, ndt)?.end
+                }
+            },
+        })
+    }
+
+    /// `T^s` of Eq. (14): the previous result (seed 000 §3.3), carried to
+    /// the scan start by the filter when scans do not abut.
+    fn fixed_ct_start(&self, last: &LastPose, scan_start: f64) -> Result<Pose, TrackError> {
+        Ok(
+            if (scan_start - last.t).abs() < 1e-9 || scan_start < last.t {
+                last.t_sensor_target.inverse()
+            } else {
+                self.filter.predict_at(scan_start)?.pose.inverse()
+            },
+        )
+    }
+
+    /// The prior on `T^s` ([`CtStart::FilterPrior`]): the filter's estimate
+    /// at the scan start, its covariance carried through the inversion to
+    /// `t_target_sensor`. The filter fuses the registration's covariance
+    /// times `filter.registration_covariance_scale`, so its covariance is
+    /// divided by that factor to be in the units of the registration's own
+    /// information, against which the prior weighs in the optimisation.
+    fn ct_start_prior(&self, scan_start: f64) -> Result<StartPrior, TrackError> {
+        let at_start = self.filter.predict_at(scan_start)?;
+        let a = inversion_jacobian(&at_start.pose);
+        let cov = a * at_start.covariance * a.transpose();
+        let cov = (cov + cov.transpose()) * 0.5;
+        // Undo what the measurements were inflated by before the filter.
+        let d = attitude_scaling(ct_attitude_scale(self.config)).try_inverse();
+        let scale = self.filter.config().registration_covariance_scale;
+        let information = d
+            .map(|d| d * cov * d)
+            .and_then(|c| c.cholesky())
+            .map(|c| c.inverse() * scale)
+            .ok_or(TrackError::NoStartPrior { t_s: scan_start })?;
+        Ok(StartPrior {
+            t_target_sensor: at_start.pose.inverse(),
+            information,
+        })
+    }
+
+    /// The priors of the free-start CT-NDT. Without a motion prior
+    /// (`TrackerConfig::ct_ndt_motion_prior_weight` = 0), the filter's
+    /// estimate at the scan start. With one, the filter's predicted motion
+    /// over the scan (turn and displacement) and no prior on the start pose:
+    /// the filter's start pose and motion together would be a prior on the
+    /// end pose, which tells the filter back what it predicted (tried: the
+    /// tumble was lost). The pose is then the points', its motion over the
+    /// scan the filter's within the filter's confidence.
+    fn ct_priors(&self, at_end: &Prediction, scan: &ScanTimes) -> Result<CtPriors, TrackError> {
+        let weight = self.config.ct_ndt_motion_prior_weight;
+        if weight == 0.0 {
+            return Ok(CtPriors {
+                start: self.ct_start_prior(scan.start_s)?,
+                rate: None,
+                displacement: None,
+            });
+        }
+        let at_start = self.filter.predict_at(scan.start_s)?;
+        let dt = scan.end_s - scan.start_s;
+        let scale = self.filter.config().registration_covariance_scale * weight;
+        // Δt² times the velocity covariances, in the start prior's units.
+        let information = |cov: Matrix3<f64>, s: f64| {
+            let cov = cov * (dt * dt);
+            ((cov + cov.transpose()) * 0.5)
+                .cholesky()
+                .map(|c| c.inverse() * s)
+                .ok_or(TrackError::NoStartPrior { t_s: scan.start_s })
+        };
+        let cov_w = at_start
+            .attitude_covariance
+            .fixed_view::<3, 3>(3, 3)
+            .into_owned();
+        let cov_v = at_start
+            .position_covariance
+            .fixed_view::<3, 3>(3, 3)
+            .into_owned();
+        let rate = RatePrior {
+            // R^e (R^s)ᵀ of t_target_sensor: Exp(-ω Δt) in the target frame.
+            turn: at_end.pose.rotation.inverse() * at_start.pose.rotation,
+            information: information(cov_w, scale * ct_attitude_scale(self.config))?,
+        };
+        let displacement = DisplacementPrior {
+            displacement_m: at_end.pose.translation - at_start.pose.translation,
+            information: information(cov_v, scale)?,
+        };
+        Ok(CtPriors {
+            start: StartPrior {
+                t_target_sensor: at_start.pose.inverse(),
+                information: Matrix6::zeros(),
+            },
+            rate: Some(rate),
+            displacement: Some(displacement),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::attitude_scaling;
+    use nalgebra::Matrix6;
+
+    /// `D C D` multiplies the attitude block by `s`, the cross blocks by
+    /// `√s`, and leaves the position block alone.
+    #[test]
+    fn attitude_scaling_scales_the_blocks() {
+        let c = Matrix6::from_fn(|i, j| 1.0 + (i + j) as f64 + if i == j { 10.0 } else { 0.0 });
+        let d = attitude_scaling(30.0);
+        let scaled = d * c * d;
+        for i in 0..6 {
+            for j in 0..6 {
+                let f = match (i < 3, j < 3) {
+                    (true, true) => 30.0,
+                    (false, false) => 1.0,
+                    _ => 30f64.sqrt(),
+                };
+                assert!((scaled[(i, j)] - f * c[(i, j)]).abs() < 1e-9, "({i}, {j})");
+            }
+        }
+        assert_eq!(attitude_scaling(1.0), Matrix6::identity());
+    }
+}

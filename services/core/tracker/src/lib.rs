@@ -1,0 +1,48 @@
+//! The tracking loop of seed 000 §3.2-3.3 as a library (no bus): each lidar
+//! frame is voxel-filtered, optionally motion-compensated, registered
+//! against the smoothed NDT map (or the ICP model), and fused into the
+//! relative-motion filter, whose prediction seeds the next frame.
+//!
+//! Modes ([`TrackingMode`]), named as in seed 000 §4.2:
+//! - `ndt`: smoothed NDT, previous pose as the initial guess (Fig. 2);
+//! - `deblur`: filter prediction as the guess plus motion compensation of
+//!   the cloud with Eq. (12) (Fig. 3);
+//! - `ct-ndt`: continuous-time NDT seeded by the filter prediction (Fig. 4);
+//! - `icp`: point-to-point ICP, previous pose as the guess (Fig. 2).
+//!
+//! Every frame yields a [`TrackOutput`] carrying the pose, its covariance,
+//! the registration's quality figures, timings and a [`TrackStatus`]
+//! (`tracking`, `degraded`, `lost`): loss is reported, never hidden.
+//!
+//! The `spacepose-tracker` service binary (`src/main.rs`) is a thin loop
+//! over [`TrackerNode`] ([`service`]), configured by
+//! [`TrackerServiceConfig`]; [`wire`] converts to the suite's messages.
+#![forbid(unsafe_code)]
+
+mod assess;
+pub mod config;
+mod dispatch;
+pub mod error;
+pub mod held_rotation;
+pub mod measurement;
+pub mod mode;
+pub mod model;
+pub mod output;
+pub mod pipeline;
+pub mod status;
+pub mod tracker;
+
+pub use config::{CtStart, LossConfig, TrackerConfig};
+pub use error::TrackError;
+pub use held_rotation::{HeldCorrection, HeldRotation, HeldRotationConfig};
+pub use mode::TrackingMode;
+pub use model::TrackingModel;
+pub use output::{Timings, TrackOutput};
+pub use pipeline::{FramePipeline, Prepared};
+pub use status::TrackStatus;
+pub use tracker::Tracker;
+
+#[cfg(test)]
+mod sim_tests;
+#[cfg(test)]
+mod tests;

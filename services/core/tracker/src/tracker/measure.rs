@@ -1,0 +1,143 @@
+//! One frame's measurement: the frame path, the mode's registration and,
+//! when CT-NDT stalled, its fallback; or why there is none.
+
+use super::{Tracker, ms};
+use crate::assess::stalled;
+use crate::dispatch::LastPose;
+use crate::mode::TrackingMode;
+use crate::pipeline::Prepared;
+use spacepose_filter::Prediction;
+use spacepose_geometry::Point;
+use spacepose_registration::{Registration, ScanTimes};
+use std::time::Instant;
+
+/// A frame's registration and how it was obtained ([`Tracker::measure`]).
+pub(super) struct Measured {
+    pub(super) registration: Registration,
+    /// The cloud was motion-compensated by the prediction (Eq. 12).
+    pub(super) compensated: bool,
+    /// Points the registration saw.
+    pub(super) points_used: usize,
+    /// Fitted by the stall fallback.
+    pub(super) fallback: bool,
+    pub(super) preprocess_ms: f64,
+    /// Registration, the fallback included.
+    pub(super) registration_ms: f64,
+}
+
+/// Why a frame carried no measurement, and what is known of it.
+pub(super) struct Missing {
+    pub(super) reason: String,
+    /// Points left after pre-processing (0 when it failed or was not the
+    /// cause).
+    pub(super) points_used: usize,
+    /// 0 when pre-processing was not the cause.
+    pub(super) preprocess_ms: f64,
+}
+
+impl Missing {
+    /// No measurement for `reason`, pre-processing aside.
+    fn because(reason: String) -> Self {
+        Self {
+            reason,
+            points_used: 0,
+            preprocess_ms: 0.0,
+        }
+    }
+}
+
+impl Tracker {
+    /// Pre-processing and registration of one frame (with the stall
+    /// fallback), or why there is no measurement: pre-processing failed, too
+    /// few points are left (`loss.min_points`: the target is not in view),
+    /// or the registration failed.
+    pub(super) fn measure(
+        &mut self,
+        points: &[Point],
+        prediction: &Prediction,
+        last: &LastPose,
+        scan: &ScanTimes,
+    ) -> Result<Measured, Missing> {
+        let pre = Instant::now();
+        let c = &self.config;
+        let Prepared { cloud, compensated } = self
+            .pipeline
+            .prepare(points, c.mode, c.ct_ndt_min_points, prediction)
+            .map_err(|e| Missing::because(e.to_string()))?;
+        let preprocess_ms = ms(pre);
+        if cloud.len() < self.config.loss.min_points {
+            let reason = format!(
+                "no measurement: {} points after pre-processing, fewer than loss.min_points = {} \
+                 (target not in view)",
+                cloud.len(),
+                self.config.loss.min_points
+            );
+            let points_used = cloud.len();
+            return Err(Missing {
+                reason,
+                points_used,
+                preprocess_ms,
+            });
+        }
+        let reg_start = Instant::now();
+        let registration = self
+            .dispatch()
+            .register(&cloud, compensated, prediction, last, scan)
+            .map_err(|e| Missing::because(e.to_string()))?;
+        let fallback =
+            self.stall_fallback(points, &registration, compensated, prediction, last, scan);
+        let (registration, compensated, points_used, fallback) = match fallback {
+            Some((r, n)) => (r, true, n, true),
+            None => (registration, compensated, cloud.len(), false),
+        };
+        Ok(Measured {
+            registration,
+            compensated,
+            points_used,
+            fallback,
+            preprocess_ms,
+            registration_ms: ms(reg_start),
+        })
+    }
+
+    /// [`TrackerConfig::ct_ndt_stall_fallback`]: when CT-NDT stalled, the
+    /// one-pose fit of the cloud compensated by the prediction (`deblur`'s
+    /// registration) and its point count; `None` otherwise, or when that
+    /// fit fails too (the stalled result then stands, and is doubted).
+    fn stall_fallback(
+        &mut self,
+        points: &[Point],
+        registration: &Registration,
+        compensated: bool,
+        prediction: &Prediction,
+        last: &LastPose,
+        scan: &ScanTimes,
+    ) -> Option<(Registration, usize)> {
+        let c = &self.config;
+        if c.mode != TrackingMode::CtNdt
+            || compensated
+            || !c.ct_ndt_stall_fallback
+            || !stalled(&c.loss, registration)
+        {
+            return None;
+        }
+        let cloud = self.pipeline.compensated(points, prediction).ok()?;
+        match self
+            .dispatch()
+            .register(&cloud, true, prediction, last, scan)
+        {
+            Ok(r) => {
+                tracing::debug!(
+                    t = scan.end_s,
+                    iterations = registration.iterations,
+                    "CT-NDT stalled: the frame is fitted as one pose on the compensated cloud"
+                );
+                Some((r, cloud.len()))
+            }
+            Err(e) => {
+                tracing::debug!(t = scan.end_s, error = %e, "CT-NDT stalled, and so did its fallback");
+                None
+            }
+        }
+    }
+}

@@ -1,0 +1,319 @@
+//! The tracking loop (seed 000 Fig. 2-4): the frame path
+//! ([`crate::pipeline`]), the mode's registration ([`crate::dispatch`]),
+//! the held rotation ([`crate::held_rotation`]), the assessment
+//! ([`crate::assess`]) and the filter, frame after frame.
+
+use crate::assess::{attitude_scaled, inconsistency, published, quality_issues};
+use crate::config::TrackerConfig;
+use crate::dispatch::{Dispatch, LastPose, ndt_params};
+use crate::error::TrackError;
+use crate::held_rotation::HeldRotation;
+use crate::measurement::{covariance_sensor_target, measurement_information};
+use crate::mode::TrackingMode;
+use crate::model::TrackingModel;
+use crate::output::{Timings, TrackOutput};
+use crate::pipeline::FramePipeline;
+use crate::status::TrackStatus;
+use nalgebra::Vector3;
+use spacepose_filter::{Prediction, RelativeMotionFilter};
+use spacepose_geometry::{Point, Pose, so3};
+use spacepose_registration::{Registration, ScanTimes};
+use std::time::Instant;
+
+mod measure;
+
+/// Follows the target frame after frame. Not thread-safe by design: one
+/// tracker per stream of frames.
+pub struct Tracker {
+    config: TrackerConfig,
+    model: TrackingModel,
+    filter: RelativeMotionFilter,
+    pipeline: FramePipeline,
+    last: Option<LastPose>,
+    lost: bool,
+    consecutive_degraded: u32,
+    /// The last registration held a rotation at the prediction (see
+    /// `TrackerConfig::release_lever_arm_m`).
+    holding: bool,
+    /// The track's recent poses and the rate a held rotation follows.
+    held: HeldRotation,
+}
+
+impl Tracker {
+    /// A tracker for `model`, not yet initialised.
+    pub fn new(config: TrackerConfig, model: TrackingModel) -> Result<Self, TrackError> {
+        config.validate()?;
+        let filter = RelativeMotionFilter::new(config.filter.clone())?;
+        let pipeline = FramePipeline::new(config.voxel_leaf_m)?;
+        let held = HeldRotation::new(config.held_rotation.clone());
+        if config.mode == TrackingMode::Icp {
+            // Only this mode needs it (crate::model): build it before the first frame.
+            model.icp()?;
+        }
+        Ok(Self {
+            config,
+            model,
+            filter,
+            pipeline,
+            last: None,
+            lost: false,
+            consecutive_degraded: 0,
+            holding: false,
+            held,
+        })
+    }
+
+    /// The configuration in force.
+    pub fn config(&self) -> &TrackerConfig {
+        &self.config
+    }
+
+    /// The current mode.
+    pub fn mode(&self) -> TrackingMode {
+        self.config.mode
+    }
+
+    /// Changes the mode between two frames; the filter state is kept.
+    /// Switching to `icp` builds the ICP model now if it was not yet
+    /// (~1 s for deos); if that fails, the mode is left unchanged.
+    pub fn set_mode(&mut self, mode: TrackingMode) -> Result<(), TrackError> {
+        if mode == TrackingMode::Icp {
+            self.model.icp()?;
+        }
+        self.config.mode = mode;
+        Ok(())
+    }
+
+    /// True once initialised and not lost.
+    pub fn is_tracking(&self) -> bool {
+        self.last.is_some() && !self.lost
+    }
+
+    /// The filter prediction at `t` (for seeding other estimators).
+    pub fn predict_at(&self, t: f64) -> Result<Prediction, TrackError> {
+        Ok(self.filter.predict_at(t)?)
+    }
+
+    /// Replaces the local filter with the authoritative state published by
+    /// the filter service (suite deployments). Ignored while the track is
+    /// not initialised or when the state is older than the local one.
+    pub fn restore_filter(&mut self, state: &Prediction) -> Result<(), TrackError> {
+        if self.last.is_none() || self.filter.time().is_some_and(|t| state.t < t) {
+            return Ok(());
+        }
+        self.filter.restore(state)?;
+        Ok(())
+    }
+
+    /// (Re)starts tracking from `t_sensor_target` at time `t` (truth before
+    /// acquisition exists, an acquisition result afterwards). Unknown rates
+    /// are passed as zeros: the filter starts at ω = 0 (seed 000 §5.2).
+    pub fn initialize(
+        &mut self,
+        t: f64,
+        t_sensor_target: &Pose,
+        v_sensor: Vector3<f64>,
+        w_target: Vector3<f64>,
+    ) -> Result<(), TrackError> {
+        self.filter
+            .initialize(t, t_sensor_target, v_sensor, w_target)?;
+        self.last = Some(LastPose {
+            t,
+            t_sensor_target: *t_sensor_target,
+        });
+        self.lost = false;
+        self.consecutive_degraded = 0;
+        self.holding = false;
+        self.held.reset();
+        Ok(())
+    }
+
+    /// Processes one frame: `points` in the sensor frame with per-point
+    /// timestamps in `[scan_start, scan_end]`.
+    ///
+    /// Per-frame failures (empty or all-NaN cloud, no correspondence,
+    /// degenerate geometry, inconsistency) are *reported* in the output's
+    /// status; `Err` is reserved for misuse (not initialised, scan times
+    /// not finite or not increasing).
+    ///
+    /// A cloud with fewer than `loss.min_points` points after pre-processing
+    /// (empty included) is no measurement: the target is not in view. It is
+    /// `lost` at once (the degraded-frames rule is for doubtful
+    /// measurements; here there is nothing to track), its pose is the filter
+    /// prediction at the scan end, [`TrackOutput::has_measurement`] is
+    /// false, and nothing is fed to the filter.
+    pub fn process(
+        &mut self,
+        points: &[Point],
+        scan_start: f64,
+        scan_end: f64,
+    ) -> Result<TrackOutput, TrackError> {
+        let started = Instant::now();
+        let last = self.last.ok_or(TrackError::NotInitialized)?;
+        check_scan_times(scan_start, scan_end, last.t)?;
+        let prediction = self.filter.predict_at(scan_end)?;
+        if self.lost {
+            return Ok(TrackOutput::lost(
+                &prediction,
+                points.len(),
+                "track lost: awaiting re-initialisation",
+                started,
+            ));
+        }
+        let scan = ScanTimes {
+            start_s: scan_start,
+            end_s: scan_end,
+        };
+        let m = match self.measure(points, &prediction, &last, &scan) {
+            Ok(m) => m,
+            Err(missing) => {
+                let mut out = self.declare_lost(&prediction, points.len(), missing.reason, started);
+                (out.points_used, out.timings.preprocess_ms) =
+                    (missing.points_used, missing.preprocess_ms);
+                return Ok(out);
+            }
+        };
+        self.holding = m.registration.degenerate_directions > 0;
+        let registration = self.held.follow(scan_end, m.registration);
+        let counts = (points.len(), m.points_used);
+        let mut out = self.assess(registration, m.compensated, &prediction, scan_end, counts)?;
+        out.fallback = m.fallback;
+        self.record_tracked(&out);
+        out.timings = Timings {
+            preprocess_ms: m.preprocess_ms,
+            registration_ms: m.registration_ms,
+            total_ms: ms(started),
+        };
+        Ok(out)
+    }
+
+    /// A frame reported `tracking` adds its pose to the history the held
+    /// rotation's rate is fitted on.
+    fn record_tracked(&mut self, out: &TrackOutput) {
+        if let (TrackStatus::Tracking, Some(r)) = (out.status, out.registration.as_ref()) {
+            self.held.record(
+                out.t,
+                &r.t_target_sensor,
+                r.weakest_lever_arm_m,
+                self.holding,
+            );
+        }
+    }
+
+    /// The registration of the current mode, with the degeneracy
+    /// handling's threshold in force (hysteresis while a rotation is held).
+    pub(crate) fn dispatch(&self) -> Dispatch<'_> {
+        let following = self.held.following().then(|| self.held.min_lever_arm_m());
+        Dispatch {
+            config: &self.config,
+            model: &self.model,
+            filter: &self.filter,
+            ndt: ndt_params(&self.config, self.holding, following),
+        }
+    }
+
+    /// Quality and consistency checks, filter update, status.
+    /// `(points_in, points_used)` are the frame's point counts before and
+    /// after pre-processing.
+    fn assess(
+        &mut self,
+        registration: Registration,
+        compensated: bool,
+        prediction: &Prediction,
+        t: f64,
+        (points_in, points_used): (usize, usize),
+    ) -> Result<TrackOutput, TrackError> {
+        let measured = registration.t_sensor_target();
+        let innovation_rot_deg =
+            so3::distance(&measured.rotation, &prediction.pose.rotation).to_degrees();
+        let innovation_pos_m = (measured.translation - prediction.pose.translation).norm();
+        let information = measurement_information(&registration, self.config.geometric_sigma_m);
+        let covariance = covariance_sensor_target(&registration.t_target_sensor, &information)
+            .map(|c| attitude_scaled(&self.config, c, compensated));
+        let mut reasons = quality_issues(&self.config, &registration);
+        reasons.extend(inconsistency(
+            &self.config.loss,
+            innovation_rot_deg,
+            innovation_pos_m,
+        ));
+        if reasons.is_empty() {
+            let outcome = self.filter.update(t, &measured, covariance)?;
+            if !outcome.fused {
+                reasons.push(format!(
+                    "filter gate: Mahalanobis² {:.1}",
+                    outcome.mahalanobis2
+                ));
+            }
+        }
+        let status = self.status_after(&mut reasons);
+        let (t_sensor_target, covariance) =
+            published(self.config.mode, status, measured, covariance, prediction);
+        self.last = Some(LastPose { t, t_sensor_target });
+        let estimate = self.filter.predict_at(t)?;
+        Ok(TrackOutput {
+            t,
+            t_sensor_target,
+            covariance,
+            status,
+            reason: reasons.join("; "),
+            registration: Some(registration),
+            innovation_rot_deg,
+            innovation_pos_m,
+            w_target: estimate.w_target,
+            v_sensor: estimate.v_sensor,
+            points_in,
+            points_used,
+            timings: Timings::default(),
+            fallback: false,
+        })
+    }
+
+    /// The status after a frame doubted for `reasons` (none: `tracking`):
+    /// `degraded`, or `lost` once `loss.max_consecutive_degraded` frames in
+    /// a row were doubted (that reason is then added).
+    fn status_after(&mut self, reasons: &mut Vec<String>) -> TrackStatus {
+        if reasons.is_empty() {
+            self.consecutive_degraded = 0;
+            return TrackStatus::Tracking;
+        }
+        self.consecutive_degraded += 1;
+        if self.consecutive_degraded < self.config.loss.max_consecutive_degraded {
+            return TrackStatus::Degraded;
+        }
+        self.lost = true;
+        reasons.push(format!(
+            "{} degraded frames in a row",
+            self.consecutive_degraded
+        ));
+        TrackStatus::Lost
+    }
+
+    fn declare_lost(
+        &mut self,
+        prediction: &Prediction,
+        points_in: usize,
+        reason: String,
+        started: Instant,
+    ) -> TrackOutput {
+        self.lost = true;
+        TrackOutput::lost(prediction, points_in, &reason, started)
+    }
+}
+
+pub(crate) fn ms(since: Instant) -> f64 {
+    since.elapsed().as_secs_f64() * 1e3
+}
+
+/// Rejects non-finite or reversed scan times, and a scan that does not end
+/// after the previous one (`previous_end_s`).
+fn check_scan_times(start_s: f64, end_s: f64, previous_end_s: f64) -> Result<(), TrackError> {
+    if start_s.is_finite() && end_s.is_finite() && start_s <= end_s && end_s > previous_end_s {
+        Ok(())
+    } else {
+        Err(TrackError::InvalidScanTimes {
+            start_s,
+            end_s,
+            previous_end_s: Some(previous_end_s),
+        })
+    }
+}

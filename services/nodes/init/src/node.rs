@@ -1,0 +1,209 @@
+//! The init node: tracker estimates and cropped clouds in, one
+//! `AcquisitionResult` per acquisition out.
+//!
+//! The newest cloud is held (a loss reported later may use it: it is not
+//! older than the loss); when the state machine wants a pose and no
+//! acquisition runs, the held frame goes to the worker thread. Each
+//! wake-up's [`Node::poll`] publishes a finished acquisition and starts
+//! the next wanted one; while one runs the node asks to be woken every
+//! [`BUSY_POLL_NS`].
+
+use crate::chain::MethodChain;
+use crate::config::InitServiceConfig;
+use crate::state::{EstimateInfo, Event, InitConfig, InitStateMachine, InitStats, Phase};
+use crate::worker::{Done, Frame, Worker};
+use spacepose_messages::{Cloud, Message, Name, ServiceKind, realtime_ns};
+use spacepose_runtime::{Ctx, Flow, Node, NodeInfo};
+use std::time::Instant;
+use tracing::{info, warn};
+
+/// While an acquisition runs, the node is polled this often (ns), so its
+/// result goes out promptly.
+pub const BUSY_POLL_NS: i64 = 10_000_000;
+
+/// Acquires when the state machine wants a pose.
+pub struct InitNode {
+    machine: InitStateMachine,
+    worker: Worker,
+    instance: Name,
+    held: Option<Frame>,
+    wake_ns: Option<i64>,
+}
+
+impl Node for InitNode {
+    const KIND: ServiceKind = ServiceKind::Init;
+    type Config = InitServiceConfig;
+
+    fn new(config: InitServiceConfig, info: &NodeInfo) -> anyhow::Result<Self> {
+        let started = Instant::now();
+        let chain = config.build_chain()?;
+        let methods: Vec<&str> = chain.methods().iter().map(|m| m.as_str()).collect();
+        info!(
+            target = config.target,
+            ?methods,
+            ms = started.elapsed().as_millis() as u64,
+            "acquisition methods ready"
+        );
+        InitNode::with_chain(chain, config.state, info.instance)
+    }
+
+    fn on_message(&mut self, msg: &Message, ctx: &mut Ctx<'_>) {
+        let Message::Pose(estimate) = msg else {
+            return;
+        };
+        match EstimateInfo::from_wire(estimate) {
+            Ok(e) => log_event(self.machine.on_estimate(&e)),
+            Err(err) => {
+                ctx.counters.rejected_wire += 1;
+                warn!("estimate refused: {err}");
+            }
+        }
+    }
+
+    fn on_cloud(&mut self, cloud: Cloud<'_>, ctx: &mut Ctx<'_>) {
+        let header = *cloud.header;
+        ctx.counters.frames_in += 1;
+        ctx.counters.last_frame = header.sequence;
+        self.machine.on_frame(header.sequence);
+        // The held frame's buffer is reused when it was not used.
+        let mut points = self.held.take().map(|f| f.points).unwrap_or_default();
+        points.clear();
+        points.extend_from_slice(cloud.points);
+        self.held = Some(Frame {
+            sequence: header.sequence,
+            scan_end_s: header.scan_end_s,
+            points,
+        });
+    }
+
+    fn poll(&mut self, ctx: &mut Ctx<'_>) -> Flow {
+        if let Some(done) = self.worker.finished() {
+            self.publish(done, ctx);
+        }
+        self.start_if_wanted();
+        self.wake_ns = self.worker.busy().then(|| ctx.now_ns + BUSY_POLL_NS);
+        Flow::Continue
+    }
+
+    fn next_wake_ns(&self) -> Option<i64> {
+        self.wake_ns
+    }
+
+    fn stop(&mut self, _: &mut Ctx<'_>) {
+        info!(stats = ?self.machine.stats(), "init service stopping");
+    }
+}
+
+impl InitNode {
+    /// A node over a built `chain`, with the state machine's timing
+    /// `state`, publishing as `instance`; starts the worker thread.
+    ///
+    /// # Errors
+    /// An invalid `state`, or the thread cannot be started.
+    pub fn with_chain(
+        chain: MethodChain,
+        state: InitConfig,
+        instance: Name,
+    ) -> anyhow::Result<Self> {
+        Ok(InitNode {
+            machine: InitStateMachine::new(state)?,
+            worker: Worker::spawn(chain)?,
+            instance,
+            held: None,
+            wake_ns: None,
+        })
+    }
+
+    /// Where the service stands.
+    pub fn phase(&self) -> Phase {
+        self.machine.phase()
+    }
+
+    /// Acquisitions, acceptances, rejections and losses so far.
+    pub fn stats(&self) -> &InitStats {
+        self.machine.stats()
+    }
+
+    /// True while an acquisition runs.
+    pub fn busy(&self) -> bool {
+        self.worker.busy()
+    }
+
+    /// Hands the held frame to the worker when the state machine wants it
+    /// and no acquisition is running.
+    fn start_if_wanted(&mut self) {
+        if self.worker.busy() {
+            return;
+        }
+        let wanted = self
+            .held
+            .as_ref()
+            .is_some_and(|h| self.machine.wants(h.sequence));
+        if let Some(frame) = self.held.take_if(|_| wanted) {
+            self.worker.start(frame);
+        }
+    }
+
+    /// Publishes a finished acquisition and tells the state machine.
+    fn publish(&mut self, done: Done, ctx: &mut Ctx<'_>) {
+        let acquisition = &done.acquisition;
+        // An empty frame is an observation (the target is not in view:
+        // ingest forwards it on purpose), not bad input: not counted.
+        if done.points_in > 0 && acquisition.points < done.points_in {
+            ctx.counters.rejected_non_finite += 1;
+        }
+        let msg = acquisition.to_wire(done.sequence, done.scan_end_s, self.instance);
+        // Stamped after the send: a tracker frame started before the result
+        // went out must not count as started after it (hand-over check).
+        // The wake-up time `now_ns` is earlier; a LocalBus clock ahead of
+        // the wall clock is never passed.
+        let published_ns = ctx
+            .send(&Message::Acquisition(msg))
+            .then(|| realtime_ns().max(ctx.now_ns));
+        if published_ns.is_some() {
+            ctx.counters.frames_out += 1;
+        }
+        let accepted = msg.success == 1 && published_ns.is_some();
+        info!(
+            sequence = done.sequence,
+            success = msg.success,
+            method = msg.method,
+            f_conv_m2 = msg.f_conv_m2,
+            time_ms = acquisition.time_ms,
+            "acquisition: {}",
+            acquisition.summary()
+        );
+        log_event(
+            self.machine
+                .on_acquisition(done.sequence, accepted, published_ns),
+        );
+    }
+}
+
+fn log_event(event: Event) {
+    match event {
+        Event::None => {}
+        Event::LossDetected { frame } => info!(frame, "track lost: acquiring"),
+        Event::HandoverFailed { frame } => {
+            warn!(
+                frame,
+                "the tracker lost the handed-over pose: acquiring again"
+            )
+        }
+        Event::TrackerTracking { frame } => info!(frame, "the tracker tracks"),
+        Event::Accepted {
+            frame,
+            delay_frames,
+        } => info!(frame, ?delay_frames, "pose acquired and handed over"),
+        Event::Rejected { frame, retry_from } => {
+            info!(
+                frame,
+                retry_from, "acquisition rejected: retrying on a later frame"
+            )
+        }
+    }
+}
+
+#[cfg(test)]
+#[path = "node_tests.rs"]
+mod tests;

@@ -1,0 +1,108 @@
+//! The service's configuration file (keys in `deploy/examples/pcd-replay.toml`).
+
+use serde::Deserialize;
+use spacepose_runtime::ServiceConfig;
+use std::path::PathBuf;
+use std::time::Duration;
+
+/// `spacepose-pcd-replay --config FILE`: the replay settings.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PcdReplayConfig {
+    /// Directory of `frame_NNNNNN.pcd` / `.ply` (and `truth.csv`).
+    pub dir: PathBuf,
+    /// Frames per second; 0 = the recorded period (truth.csv), else 1 Hz.
+    pub rate_hz: f64,
+    /// Start again after the last frame.
+    #[serde(rename = "loop")]
+    pub looping: bool,
+    /// Exit after the last frame (no loop); otherwise keep sending heartbeats.
+    pub exit_at_end: bool,
+    /// Sensor id written in the cloud headers.
+    pub sensor_id: u16,
+}
+
+impl Default for PcdReplayConfig {
+    fn default() -> Self {
+        PcdReplayConfig {
+            dir: PathBuf::from("frames"),
+            rate_hz: 0.0,
+            looping: false,
+            exit_at_end: false,
+            sensor_id: 0,
+        }
+    }
+}
+
+impl ServiceConfig for PcdReplayConfig {
+    fn validate(&self) -> Result<(), String> {
+        if !(self.rate_hz.is_finite() && self.rate_hz >= 0.0) {
+            return Err(format!(
+                "rate_hz must be finite and >= 0, got {}",
+                self.rate_hz
+            ));
+        }
+        if self.dir.as_os_str().is_empty() {
+            return Err("dir must not be empty".into());
+        }
+        Ok(())
+    }
+}
+
+impl PcdReplayConfig {
+    /// The frame period: `1 / rate_hz`, else the recording's (`recorded_s`,
+    /// from `truth.csv`), else 1 s.
+    pub fn period(&self, recorded_s: Option<f64>) -> Duration {
+        let one_second = Duration::from_secs(1);
+        if self.rate_hz > 0.0 {
+            Duration::try_from_secs_f64(1.0 / self.rate_hz).unwrap_or(one_second)
+        } else {
+            recorded_s
+                .and_then(|s| Duration::try_from_secs_f64(s).ok())
+                .unwrap_or(one_second)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `deploy/examples/pcd-replay.toml` parses and shows the defaults.
+    #[test]
+    fn the_deploy_example_parses_and_shows_the_defaults() {
+        let text = include_str!(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../../deploy/examples/pcd-replay.toml"
+        ));
+        let c: PcdReplayConfig = toml::from_str(text).unwrap();
+        c.validate().unwrap();
+        assert_eq!(c, PcdReplayConfig::default());
+    }
+
+    #[test]
+    fn keys_parse_and_bad_values_fail() {
+        let c: PcdReplayConfig =
+            toml::from_str("dir = \"rec\"\nrate_hz = 4.0\nloop = true\nsensor_id = 3\n").unwrap();
+        assert_eq!(
+            (c.dir.to_str(), c.looping, c.sensor_id),
+            (Some("rec"), true, 3)
+        );
+        assert!(toml::from_str::<PcdReplayConfig>("looping = true").is_err());
+        let c: PcdReplayConfig = toml::from_str("rate_hz = nan").unwrap();
+        assert!(c.validate().unwrap_err().contains("rate_hz"));
+        let c: PcdReplayConfig = toml::from_str("dir = \"\"").unwrap();
+        assert!(c.validate().unwrap_err().contains("dir"));
+    }
+
+    #[test]
+    fn the_period_is_the_rate_the_recording_or_a_second() {
+        let at = |rate_hz| PcdReplayConfig {
+            rate_hz,
+            ..PcdReplayConfig::default()
+        };
+        assert_eq!(at(25.0).period(Some(2.0)), Duration::from_millis(40));
+        assert_eq!(at(0.0).period(Some(0.5)), Duration::from_millis(500));
+        assert_eq!(at(0.0).period(None), Duration::from_secs(1));
+    }
+}

@@ -1,0 +1,115 @@
+//! The suite sub-commands: command-line arguments to the modules' `run`.
+
+use super::demo::DemoOptions;
+use super::up::Overrides;
+use crate::cli::{DemoArgs, GroundArgs, PrefixArgs, SwapArgs, UpArgs, ZenohOverrideArgs};
+use crate::ground::GroundOptions;
+use anyhow::{Result, bail};
+use std::time::Duration;
+
+fn overrides(a: &ZenohOverrideArgs) -> Overrides {
+    Overrides {
+        prefix: a.prefix.clone(),
+        listen: (!a.listen.is_empty()).then(|| a.listen.clone()),
+        connect: (!a.connect.is_empty()).then(|| a.connect.clone()),
+        host: None,
+    }
+}
+
+fn up_overrides(a: &UpArgs) -> Overrides {
+    Overrides {
+        host: a.host.clone(),
+        ..overrides(&a.overrides)
+    }
+}
+
+fn seconds(name: &str, s: f64) -> Result<Duration> {
+    if !(s.is_finite() && s >= 0.0) {
+        bail!("{name} must be a non-negative number of seconds, got {s}");
+    }
+    Ok(Duration::from_secs_f64(s))
+}
+
+/// `spacepose up`.
+pub fn up(a: &UpArgs) -> Result<()> {
+    super::up::run(&a.deploy, &up_overrides(a), &mut std::io::stdout())
+}
+
+/// `spacepose supervise` (started by `up`).
+pub fn supervise(a: &UpArgs) -> Result<()> {
+    super::up::supervise(&a.deploy, &up_overrides(a))
+}
+
+/// `spacepose swap`.
+pub fn swap(a: &SwapArgs) -> Result<()> {
+    let kind: spacepose_messages::ServiceKind = toml::Value::String(a.kind.clone())
+        .try_into()
+        .map_err(|_| anyhow::anyhow!("unknown service kind {:?}", a.kind))?;
+    let req = super::swap::SwapRequest {
+        kind,
+        mode: a.mode.clone(),
+        binary: a.binary.clone(),
+    };
+    super::up::request_swap(
+        a.prefix.as_deref(),
+        &req,
+        seconds("--timeout-s", a.timeout_s)?,
+        &mut std::io::stdout(),
+    )
+}
+
+/// `spacepose status`.
+pub fn status(a: &PrefixArgs) -> Result<()> {
+    super::status::run(a.prefix.as_deref(), &mut std::io::stdout())
+}
+
+/// `spacepose down`.
+pub fn down(a: &PrefixArgs) -> Result<()> {
+    super::down::run(a.prefix.as_deref(), &mut std::io::stdout())
+}
+
+/// `spacepose demo`.
+pub fn demo(a: &DemoArgs) -> Result<()> {
+    let opts = DemoOptions {
+        deploy: a.deploy.clone(),
+        frames: a.frames,
+        warmup: a.warmup,
+        json: a.json.clone(),
+        overrides: overrides(&a.overrides),
+        linger: seconds("--linger-s", a.linger_s)?,
+        chaos: a
+            .chaos
+            .iter()
+            .map(|c| super::demo::chaos::ChaosSpec::parse(c))
+            .collect::<Result<_>>()?,
+        swap: a
+            .swap
+            .as_deref()
+            .map(super::demo::chaos::SwapSpec::parse)
+            .transpose()?,
+    };
+    super::demo::run(&opts, &mut std::io::stdout())?;
+    Ok(())
+}
+
+/// `spacepose ground`.
+pub fn ground(a: &GroundArgs) -> Result<()> {
+    let connect = if a.connect.is_empty() && a.listen.is_empty() {
+        vec![super::descriptor::DEFAULT_LISTEN.to_string()]
+    } else {
+        a.connect.clone()
+    };
+    let opts = GroundOptions {
+        connect,
+        listen: a.listen.clone(),
+        prefix: a.prefix.clone(),
+        record: a.record.clone(),
+        duration: a.duration.map(|d| seconds("--duration", d)).transpose()?,
+        count: a.count,
+        refresh: (a.refresh_s > 0.0)
+            .then(|| seconds("--refresh-s", a.refresh_s))
+            .transpose()?,
+    };
+    crate::ground::run(&opts, &mut std::io::stdout())?;
+    Ok(())
+}
