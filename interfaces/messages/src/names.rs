@@ -17,7 +17,7 @@ pub const MAX_PREFIX_LEN: usize = 32;
 pub enum Topic {
     /// Raw frames from the sensor (or simulator / replay): `CloudHeader` + `[WirePoint]`.
     RawCloud,
-    /// Cropped and voxel-filtered frames from ingest: `CloudHeader` + `[WirePoint]`.
+    /// Frames cropped to the target by ingest (the raw points, not voxel-filtered): `CloudHeader` + `[WirePoint]`.
     Cloud,
     /// `PoseEstimate` from the tracker(s).
     Pose,

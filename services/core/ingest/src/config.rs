@@ -63,12 +63,9 @@ pub struct IngestConfig {
     /// A prediction older than this at scan end (s) is not trusted and the
     /// frame is cropped as before acquisition.
     pub max_prediction_age_s: f64,
-    /// Voxel edge of the down-sampling (m, seed 000 §3.3); `0` disables it.
-    pub leaf_size_m: f64,
     /// Largest accepted frame (points); larger frames are rejected.
     pub max_points: usize,
-    /// A forwarded frame with fewer points than this after the crop and the
-    /// voxel filter is counted (and logged) as "target not seen"
+    /// A forwarded frame with fewer points than this after the crop is counted (and logged) as "target not seen"
     /// (`IngestStats::frames_without_target`). Counting only: the frame is
     /// forwarded either way, and the tracker decides with its own
     /// `loss.min_points` whether it can register it. >= 1. Default 20, the
@@ -87,7 +84,7 @@ pub struct IngestConfig {
 
 impl Default for IngestConfig {
     /// 0.5-60 m range gate, `deos` bounding radius and body box, 0.25 m
-    /// margin, 10 s prediction age, 2 cm voxels, 200,000 points, target not
+    /// margin, 10 s prediction age, 200,000 points, target not
     /// seen below 20 points, no static box.
     fn default() -> Self {
         IngestConfig {
@@ -96,7 +93,6 @@ impl Default for IngestConfig {
             target_bounding_radius_m: 1.6008,
             margin_m: 0.25,
             max_prediction_age_s: 10.0,
-            leaf_size_m: 0.02,
             max_points: DEFAULT_MAX_POINTS,
             min_target_points: 20,
             static_box: None,
@@ -120,7 +116,6 @@ impl IngestConfig {
         positive("target_bounding_radius_m", self.target_bounding_radius_m)?;
         non_negative("margin_m", self.margin_m)?;
         positive("max_prediction_age_s", self.max_prediction_age_s)?;
-        non_negative("leaf_size_m", self.leaf_size_m)?;
         if self.max_points == 0 {
             return Err(invalid("max_points", 0.0, "must be >= 1"));
         }
@@ -200,7 +195,6 @@ mod tests {
         )
         .unwrap();
         assert_eq!(c.margin_m, 0.1);
-        assert_eq!(c.leaf_size_m, 0.02);
         assert!(c.static_box.unwrap().contains([0.0, 0.0, 10.0]));
         assert!(!c.static_box.unwrap().contains([0.0, 0.0, 40.0]));
         c.validate().unwrap();
@@ -221,10 +215,6 @@ mod tests {
             },
             IngestConfig {
                 target_bounding_radius_m: 0.0,
-                ..Default::default()
-            },
-            IngestConfig {
-                leaf_size_m: f64::INFINITY,
                 ..Default::default()
             },
             IngestConfig {

@@ -1,6 +1,5 @@
 //! The error type of the ingest library.
 
-use spacepose_geometry::GeometryError;
 
 /// Everything that can go wrong while ingesting a frame or building the
 /// ingest stage. A rejected frame is one of these values, never a panic.
@@ -46,8 +45,4 @@ pub enum IngestError {
         /// Scan end (s).
         scan_end_s: f64,
     },
-
-    /// The voxel filter failed (a point absurdly far from the origin).
-    #[error("voxel filter: {0}")]
-    Voxel(#[from] GeometryError),
 }

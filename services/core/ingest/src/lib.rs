@@ -7,8 +7,12 @@
 //! 2. Crop to the target's region of interest ([`Roi`]): the lidar also sees
 //!    the test facility (floor, back wall, robot arm), which "would not be
 //!    observed in space" and is cropped out (seed 000 §4.1).
-//! 3. Voxel filter keeping the mean timestamp per voxel (seed 000 §3.3), so
-//!    the continuous-time registration still knows when each point was taken.
+//!
+//! Ingest does not voxel-filter: the tracker motion-compensates the raw
+//! points of each frame before its voxel filter (the one frame path,
+//! `spacepose_tracker::pipeline`), and the init service voxel-filters what
+//! it acquires on. A voxel's mean point cannot be compensated by its mean
+//! timestamp, so a voxel filter here would come before the compensation.
 //!
 //! # "Target not seen" is an observation, not bad input
 //!

@@ -1,11 +1,10 @@
-//! The ingest stage: validate, crop to the region of interest, voxel-filter
-//! keeping timestamps (seed 000 §3.3).
+//! The ingest stage: validate, crop to the region of interest.
 
 use crate::config::IngestConfig;
 use crate::error::IngestError;
 use crate::roi::{Roi, RoiKind, TargetPrediction};
 use crate::stats::IngestStats;
-use spacepose_geometry::{Point, VoxelFilter};
+use spacepose_geometry::Point;
 
 /// What happened to one accepted frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -16,9 +15,7 @@ pub struct FrameReport {
     pub non_finite_points: usize,
     /// Finite points outside the region of interest.
     pub cropped_points: usize,
-    /// Points inside the region of interest (before voxel filtering).
-    pub roi_points: usize,
-    /// Points out (after voxel filtering).
+    /// Points out: the finite points inside the region of interest.
     pub output_points: usize,
     /// False when fewer than `IngestConfig::min_target_points` points came
     /// out: the frame is the observation "target not seen" (still forwarded).
@@ -27,12 +24,10 @@ pub struct FrameReport {
     pub roi: RoiKind,
 }
 
-/// Crop + voxel filter, with reusable buffers and running statistics.
+/// The crop, with running statistics.
 #[derive(Debug, Clone)]
 pub struct IngestStage {
     config: IngestConfig,
-    voxel: Option<VoxelFilter>,
-    roi_points: Vec<Point>,
     stats: IngestStats,
 }
 
@@ -40,15 +35,8 @@ impl IngestStage {
     /// A stage after validating `config`.
     pub fn new(config: IngestConfig) -> Result<Self, IngestError> {
         config.validate()?;
-        let voxel = if config.leaf_size_m > 0.0 {
-            Some(VoxelFilter::new(config.leaf_size_m)?)
-        } else {
-            None
-        };
         Ok(IngestStage {
             config,
-            voxel,
-            roi_points: Vec::new(),
             stats: IngestStats::default(),
         })
     }
@@ -85,7 +73,7 @@ impl IngestStage {
     ///
     /// # Errors
     /// [`IngestError::Oversized`], [`IngestError::AllNonFinite`],
-    /// [`IngestError::BadScanInterval`] or [`IngestError::Voxel`]; each is
+    /// or [`IngestError::BadScanInterval`]; each is
     /// counted in [`IngestStats`].
     pub fn process_into(
         &mut self,
@@ -135,16 +123,10 @@ impl IngestStage {
             });
         }
         let (roi, issue) = Roi::for_frame(&self.config, prediction, scan_start_s, scan_end_s);
-        let crop = crop_into(&roi, points, &mut self.roi_points);
+        let crop = crop_into(&roi, points, out);
         // An empty frame (n = 0) is not "all non-finite": it goes through.
         if n > 0 && crop.non_finite == n {
             return Err(IngestError::AllNonFinite { points: n });
-        }
-        match &mut self.voxel {
-            Some(voxel) => {
-                voxel.filter_into(&self.roi_points, out)?;
-            }
-            None => out.extend_from_slice(&self.roi_points),
         }
         let target_seen = out.len() >= self.config.min_target_points;
         let s = &mut self.stats;
@@ -156,12 +138,11 @@ impl IngestStage {
         s.cropped_points += crop.outside as u64;
         s.ignored_predictions += u64::from(issue.is_some());
         s.frames_without_prediction += u64::from(roi.centre().is_none());
-        s.frames_empty_after_crop += u64::from(self.roi_points.is_empty());
+        s.frames_empty_after_crop += u64::from(out.is_empty());
         Ok(FrameReport {
             input_points: n,
             non_finite_points: crop.non_finite,
             cropped_points: crop.outside,
-            roi_points: self.roi_points.len(),
             output_points: out.len(),
             target_seen,
             roi: roi.kind(),

@@ -1,4 +1,4 @@
-//! Bad input and the voxel step of [`IngestStage`].
+//! Bad input and the crop of [`IngestStage`].
 
 use crate::{IngestConfig, IngestError, IngestStage, RoiKind, TargetPrediction};
 use nalgebra::Vector3;
@@ -67,7 +67,7 @@ fn bad_frames_are_rejected_counted_and_the_next_frame_still_passes() {
     mixed[9].intensity = f32::NEG_INFINITY;
     let (out, report) = s.process(&mixed, 0.0, 1.0, None).unwrap();
     assert_eq!(report.non_finite_points, 3);
-    assert_eq!(report.roi_points, 1997);
+    assert_eq!(report.output_points, 1997);
     assert!(!out.is_empty() && out.iter().all(Point::is_finite));
     let (_, report) = s.process(&good, 0.0, 1.0, None).unwrap();
     assert_eq!(report.non_finite_points, 0);
@@ -111,35 +111,18 @@ fn frames_without_the_target_are_forwarded_as_observations() {
 }
 
 #[test]
-fn voxel_filter_reduces_the_cloud_and_keeps_mean_timestamps() {
-    // Two points per 2 cm voxel: pairs 1 mm apart at times 2k and 2k+1 ms.
+fn the_crop_keeps_every_point_inside_in_time_order() {
+    // Two points per 2 cm cell, 1 mm apart: nothing is merged (the tracker
+    // voxel-filters after its motion compensation).
     let mut pts = Vec::new();
     for k in 0..500 {
         let x = 0.02 * k as f32 + 0.005;
         pts.push(Point::new(x, 0.005, 10.005, 1.0, 0.002 * k as f64));
-        pts.push(Point::new(
-            x + 0.001,
-            0.005,
-            10.005,
-            3.0,
-            0.002 * k as f64 + 0.001,
-        ));
+        pts.push(Point::new(x + 0.001, 0.005, 10.005, 3.0, 0.002 * k as f64 + 0.001));
     }
     let mut s = stage();
     let (out, report) = s.process(&pts, 0.0, 1.0, None).unwrap();
-    assert_eq!(report.roi_points, 1000);
-    assert_eq!(out.len(), 500);
-    for (k, p) in out.iter().enumerate() {
-        assert!((p.t - (0.002 * k as f64 + 0.0005)).abs() < 1e-9);
-        assert!((p.intensity - 2.0).abs() < 1e-6);
-    }
-    // leaf_size_m = 0 disables the voxel step.
-    let mut raw = IngestStage::new(IngestConfig {
-        leaf_size_m: 0.0,
-        ..IngestConfig::default()
-    })
-    .unwrap();
-    let (out, _) = raw.process(&pts, 0.0, 1.0, None).unwrap();
+    assert_eq!(report.output_points, 1000);
     assert_eq!(out, pts);
 }
 
@@ -158,16 +141,16 @@ fn a_prediction_crops_to_the_sphere_and_a_wrong_one_empties_the_frame() {
     };
     let (_, r) = s.process(&pts, 0.0, 1.0, Some(&pred)).unwrap();
     assert_eq!(r.roi, RoiKind::Predicted);
-    assert_eq!((r.roi_points, r.cropped_points), (1000, 2));
+    assert_eq!((r.output_points, r.cropped_points), (1000, 2));
     let (_, r) = s.process(&pts, 0.0, 1.0, None).unwrap();
     assert_eq!(r.roi, RoiKind::RangeOnly);
-    assert_eq!((r.roi_points, r.cropped_points), (1001, 1));
+    assert_eq!((r.output_points, r.cropped_points), (1001, 1));
     let far = TargetPrediction {
         p_sensor_target: Vector3::new(0.0, 0.0, 30.0),
         ..pred
     };
     let (out, r) = s.process(&pts, 0.0, 1.0, Some(&far)).unwrap();
-    assert!(out.is_empty() && r.roi_points == 0);
+    assert!(out.is_empty() && r.output_points == 0);
     assert_eq!(s.stats().frames_empty_after_crop, 1);
     assert_eq!(s.stats().frames_without_prediction, 1);
 }

@@ -13,14 +13,14 @@ pub struct IngestStats {
     /// nothing, e.g. it looked away): forwarded as empty clouds, not rejected.
     pub empty_frames: u64,
     /// Forwarded frames with fewer than `IngestConfig::min_target_points`
-    /// points after the crop and the voxel filter (empty frames included):
+    /// points after the crop (empty frames included):
     /// the observation "target not seen".
     pub frames_without_target: u64,
     /// Frames rejected because they exceeded `max_points`.
     pub rejected_oversized: u64,
     /// Frames rejected because every point was non-finite.
     pub rejected_all_non_finite: u64,
-    /// Frames rejected for another reason (bad scan interval, voxel error).
+    /// Frames rejected for another reason (bad scan interval).
     pub rejected_other: u64,
     /// Frames that had at least one non-finite point (all-NaN frames included).
     pub frames_with_non_finite: u64,

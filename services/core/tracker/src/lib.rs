@@ -1,7 +1,9 @@
 //! The tracking loop of seed 000 §3.2-3.3 as a library (no bus): each lidar
-//! frame is voxel-filtered, optionally motion-compensated, registered
-//! against the smoothed NDT map (or the ICP model), and fused into the
-//! relative-motion filter, whose prediction seeds the next frame.
+//! frame (cropped raw points) goes through the one frame path
+//! ([`pipeline`]: motion compensation in the modes that compensate, then
+//! the voxel filter), is registered against the smoothed NDT map (or the
+//! ICP model), and fused into the relative-motion filter, whose prediction
+//! seeds the next frame.
 //!
 //! Modes ([`TrackingMode`]), named as in seed 000 §4.2:
 //! - `ndt`: smoothed NDT, previous pose as the initial guess (Fig. 2);
@@ -14,9 +16,8 @@
 //! the registration's quality figures, timings and a [`TrackStatus`]
 //! (`tracking`, `degraded`, `lost`): loss is reported, never hidden.
 //!
-//! The `spacepose-tracker` service binary (`src/main.rs`) is a thin loop
-//! over [`TrackerNode`] ([`service`]), configured by
-//! [`TrackerServiceConfig`]; [`wire`] converts to the suite's messages.
+//! The `spacepose-tracker` service (`services/nodes/tracker`) runs it on
+//! the bus; `spacepose eval tracking` runs that same node in one process.
 #![forbid(unsafe_code)]
 
 mod assess;

@@ -3,7 +3,7 @@
 
 use crate::error::InitError;
 use crate::method::{Attempt, PoseAcquirer};
-use spacepose_geometry::Point;
+use spacepose_geometry::{Point, voxel_filter};
 use spacepose_messages::AcquisitionMethod;
 use std::time::Instant;
 
@@ -74,6 +74,8 @@ impl Acquisition {
 pub struct MethodChain {
     methods: Vec<Box<dyn PoseAcquirer>>,
     min_points: usize,
+    /// Voxel edge of the cloud the methods see (m); `None`: the points.
+    voxel_leaf_m: Option<f64>,
 }
 
 impl MethodChain {
@@ -88,7 +90,23 @@ impl MethodChain {
         Ok(Self {
             methods,
             min_points,
+            voxel_leaf_m: None,
         })
+    }
+
+    /// The chain with the frame voxel-filtered at `leaf_size_m` (m) before
+    /// the methods see it (seed 000 §3.3's filter; 0: the points as they
+    /// are). Ingest used to do this for every consumer; since the tracker
+    /// compensates the raw points before its own voxel filter (the one
+    /// frame path), acquisition does its own, so its input is unchanged.
+    pub fn with_voxels(mut self, leaf_size_m: f64) -> Result<Self, InitError> {
+        if !(leaf_size_m.is_finite() && leaf_size_m >= 0.0) {
+            return Err(InitError::InvalidConfig(format!(
+                "leaf_size_m = {leaf_size_m} must be finite and >= 0"
+            )));
+        }
+        self.voxel_leaf_m = (leaf_size_m > 0.0).then_some(leaf_size_m);
+        Ok(self)
     }
 
     /// The first method (the chain holds at least one).
@@ -107,15 +125,29 @@ impl MethodChain {
     pub fn acquire(&self, cloud: &[Point]) -> Acquisition {
         let started = Instant::now();
         let finite: Vec<Point> = cloud.iter().copied().filter(Point::is_finite).collect();
+        let points = finite.len();
+        let finite = match self.voxel_leaf_m.map(|leaf| voxel_filter(&finite, leaf)) {
+            None => finite,
+            Some(Ok(v)) => v.points,
+            Some(Err(e)) => {
+                return Acquisition {
+                    attempts: Vec::new(),
+                    first_method: self.first_method(),
+                    points,
+                    skipped: Some(format!("voxel filter: {e}")),
+                    time_ms: started.elapsed().as_secs_f64() * 1e3,
+                };
+            }
+        };
         if finite.len() < self.min_points {
             // No target in view (an empty frame from ingest, or a few stray
             // points): no method can run, and none is blamed.
             return Acquisition {
                 attempts: Vec::new(),
                 first_method: self.first_method(),
-                points: finite.len(),
+                points,
                 skipped: Some(format!(
-                    "no target in view (too few points: {} finite of {}, need {})",
+                    "no target in view (too few points: {} used, {points} finite of {}, need {})",
                     finite.len(),
                     cloud.len(),
                     self.min_points
@@ -141,7 +173,7 @@ impl MethodChain {
         Acquisition {
             attempts,
             first_method: self.first_method(),
-            points: finite.len(),
+            points,
             skipped: None,
             time_ms: started.elapsed().as_secs_f64() * 1e3,
         }

@@ -41,9 +41,13 @@ pub struct InitServiceConfig {
     /// Methods tried in order on each frame; the first accepted pose wins
     /// (issue 6 will put the CNN first, template matching as the fallback).
     pub methods: Vec<MethodKind>,
-    /// A frame with fewer finite points is a failure without trying any
-    /// method (seed 002's sparse-cloud case).
+    /// A frame with fewer finite points (after the voxel filter) is a
+    /// failure without trying any method (seed 002's sparse-cloud case).
     pub min_points: usize,
+    /// Voxel edge of the cloud the methods see (m, seed 000 §3.3; 0: the
+    /// cropped points as they are). 2 cm, the filter ingest applied before
+    /// the voxel filter moved behind the tracker's motion compensation.
+    pub leaf_size_m: f64,
     /// When to acquire, retry and give up on a hand-over.
     pub state: InitConfig,
     /// Template matching, refinement and f_MAX.
@@ -61,6 +65,7 @@ impl Default for InitServiceConfig {
             instance: None,
             methods: vec![MethodKind::TemplateMatching],
             min_points: 20,
+            leaf_size_m: 0.02,
             state: InitConfig::default(),
             template_matching: TemplateMatchingConfig::default(),
             cnn: CnnMethodConfig::default(),
@@ -92,6 +97,9 @@ impl InitServiceConfig {
         }
         if self.methods.contains(&MethodKind::Cnn) {
             self.cnn.validate()?;
+        }
+        if !(self.leaf_size_m.is_finite() && self.leaf_size_m >= 0.0) {
+            return bad(format!("leaf_size_m = {} must be >= 0", self.leaf_size_m));
         }
         if self.min_points < 3 {
             return bad(format!("min_points = {} must be >= 3", self.min_points));
@@ -128,7 +136,7 @@ impl InitServiceConfig {
                 }
             }
         }
-        MethodChain::new(methods, self.min_points)
+        MethodChain::new(methods, self.min_points)?.with_voxels(self.leaf_size_m)
     }
 }
 
