@@ -2,12 +2,15 @@
 //! place each message is turned into what a node works with.
 //!
 //! - here: arrays, quaternions, poses, 6x6 matrices;
+//! - `pose_access`: `pose()` / `set_pose()` on every message that carries
+//!   `t_sensor_target`;
 //! - [`filter`]: `FilterState` ↔ the filter's `Prediction`, a `PoseEstimate`
 //!   as a measurement, an `AcquisitionResult` as a starting pose.
 //!
 //! Quaternions travel in the order **w, x, y, z** (scalar first).
 
 pub mod filter;
+mod pose_access;
 
 pub use filter::{
     Measurement, acquisition_pose, measurement_from_estimate, prediction_from_state,
@@ -15,7 +18,6 @@ pub use filter::{
 };
 
 use crate::error::MessageError;
-use crate::{AcquisitionResult, Command, FilterState, PoseEstimate, TruthMsg};
 use nalgebra::{Matrix6, Quaternion, Rotation3, UnitQuaternion, Vector3};
 use spacepose_geometry::Pose;
 
@@ -86,33 +88,10 @@ pub fn matrix6_from_wire(m: &[[f64; 6]; 6]) -> Matrix6<f64> {
     Matrix6::from_fn(|r, c| m[r][c])
 }
 
-macro_rules! pose_access {
-    ($($ty:ty),*) => {$(
-        impl $ty {
-            /// The carried `t_sensor_target` as a geometry pose (checked).
-            pub fn pose(&self) -> Result<Pose, MessageError> {
-                pose_from_wire(&self.q_sensor_target, &self.p_sensor_target)
-            }
-
-            /// Stores `t_sensor_target` (quaternion w, x, y, z; position m).
-            pub fn set_pose(&mut self, pose: &Pose) {
-                (self.q_sensor_target, self.p_sensor_target) = pose_to_wire(pose);
-            }
-        }
-    )*};
-}
-
-pose_access!(
-    PoseEstimate,
-    FilterState,
-    AcquisitionResult,
-    TruthMsg,
-    Command
-);
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::PoseEstimate;
     use approx::assert_relative_eq;
     use spacepose_geometry::so3;
 

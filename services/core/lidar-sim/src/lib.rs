@@ -21,6 +21,7 @@ pub mod clutter;
 pub mod config;
 pub mod detection;
 pub mod error;
+pub mod frame;
 mod measurement;
 pub mod optics;
 pub mod pattern;
@@ -34,7 +35,8 @@ pub use config::{Effects, RASTER_SCAN_TIME_S, SensorConfig, SurfaceModel};
 pub use detection::{DetectionModel, DetectionParams};
 pub use error::SimError;
 pub use pattern::{Scan, ScanPattern, ScanRays};
-pub use simulator::{Frame, LidarSimulator, ReturnKind};
+pub use frame::{Frame, ReturnKind};
+pub use simulator::LidarSimulator;
 pub use source::FrameSource;
 pub use surface::Surface;
 

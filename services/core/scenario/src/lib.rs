@@ -48,6 +48,7 @@
 #![forbid(unsafe_code)]
 
 pub mod attitude;
+mod builder;
 pub mod chaser;
 pub mod config;
 pub mod error;
@@ -60,33 +61,13 @@ pub mod relative;
 pub mod scenario;
 pub mod truth;
 
+pub use builder::build;
 pub use config::{ScenarioConfig, ScenarioKind};
 pub use error::ScenarioError;
 pub use look_away::{LookAway, LookingAway};
 pub use random::random_frame_euler;
 pub use scenario::Scenario;
 pub use truth::TruthState;
-
-/// Builds the scenario a (validated) configuration describes.
-pub fn build(config: &ScenarioConfig) -> Result<Box<dyn Scenario>, ScenarioError> {
-    config.validate()?;
-    let scenario: Box<dyn Scenario> = match config.kind {
-        ScenarioKind::SlowSpin => Box::new(presets::slow_spin(config)),
-        ScenarioKind::Tumbling => Box::new(presets::tumbling(config)),
-        ScenarioKind::Ellipse => Box::new(presets::ellipse(config)),
-        ScenarioKind::Random => Box::new(random::RandomAttitudes {
-            seed: config.seed,
-            frame_period_s: config.frame_period_s,
-            frames: config.random_frames,
-            range_m: config.range_m,
-            lateral_offset_rad: config.lateral_offset_deg.to_radians(),
-        }),
-    };
-    Ok(match &config.look_away {
-        Some(look) => Box::new(LookingAway::new(scenario, look)?),
-        None => scenario,
-    })
-}
 
 #[cfg(test)]
 mod tests;
