@@ -2,8 +2,8 @@
 //! user header, Static allocation sized to the largest frame.
 
 use crate::error::BusError;
-use crate::node::{Bus, EventFactory};
-use crate::pubsub::Wakeable;
+use crate::node::Bus;
+use crate::waiter::{EventFactory, Wakeable};
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher as IoxPublisher;
 use iceoryx2::port::subscriber::Subscriber as IoxSubscriber;

@@ -30,8 +30,8 @@ pub use bridge::{Bridge, BridgeStats, Direction, LinkLatency, Route};
 pub use cloud::{CloudPublisher, CloudSample, CloudSubscriber};
 pub use error::BusError;
 pub use node::{Bus, cleanup_dead_nodes, iceoryx2_config};
-pub use pubsub::{Msg, Publisher, Subscriber, Wakeable};
-pub use waiter::{Waiter, WakeReason};
+pub use pubsub::{Msg, Publisher, Subscriber};
+pub use waiter::{Waiter, WakeReason, Wakeable};
 pub use zenoh_access::{AccessControl, Credentials};
 pub use zenoh_session::{
     DEFAULT_ZENOH_PORT, ZenohConfig, is_loopback_endpoint, open_zenoh, open_zenoh_with,

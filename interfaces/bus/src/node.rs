@@ -3,16 +3,13 @@
 
 use crate::error::BusError;
 use crate::limits::*;
-use crate::waiter::Waiter;
+use crate::waiter::{EventFactory, Waiter};
 use iceoryx2::node::{NodeView, NodeWaitFailure};
 use iceoryx2::prelude::*;
-use iceoryx2::service::port_factory::{event, publish_subscribe};
+use iceoryx2::service::port_factory::publish_subscribe;
 use spacepose_messages::{CloudHeader, Name, Names, WirePoint};
 use std::fmt::Debug;
 use std::time::Duration;
-
-/// Event (wake-up) service of a topic.
-pub(crate) type EventFactory = event::PortFactory<ipc::Service>;
 
 /// One iceoryx2 node per process, isolated by the deployment prefix.
 pub struct Bus {

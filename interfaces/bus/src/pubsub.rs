@@ -2,7 +2,8 @@
 //! paired with an event notifier so subscribers wake without polling.
 
 use crate::error::BusError;
-use crate::node::{Bus, EventFactory};
+use crate::node::Bus;
+use crate::waiter::EventFactory;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher as IoxPublisher;
 use iceoryx2::port::subscriber::Subscriber as IoxSubscriber;
@@ -10,20 +11,13 @@ use iceoryx2::prelude::*;
 use spacepose_messages::{WireMessage, ZeroCopySend, realtime_ns};
 use std::fmt::Debug;
 
+pub use crate::waiter::Wakeable;
+
 /// A fixed-size message of the suite: `#[repr(C)]`, `ZeroCopySend`, and in
 /// the postcard codec (every message type of `spacepose-messages` is one).
 pub trait Msg: Debug + Copy + ZeroCopySend + WireMessage + 'static {}
 
 impl<T: Debug + Copy + ZeroCopySend + WireMessage + 'static> Msg for T {}
-
-/// Something a [`crate::Waiter`] can wait on: a subscriber with its event service.
-pub trait Wakeable {
-    /// Name of the service (for errors and logs).
-    fn service_name(&self) -> &str;
-    /// The event service notified after every send on the topic.
-    #[doc(hidden)]
-    fn event_factory(&self) -> &EventFactory;
-}
 
 /// Publisher of one fixed-size message type.
 pub struct Publisher<T: Msg> {

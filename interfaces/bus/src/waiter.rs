@@ -1,11 +1,23 @@
 //! Event-driven wake-up: a WaitSet over the listeners of attached subscribers.
 
 use crate::error::BusError;
-use crate::pubsub::Wakeable;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::event;
 use iceoryx2::waitset::WaitSetRunResult;
 use std::time::Duration;
+
+/// Event (wake-up) service of a topic.
+pub(crate) type EventFactory = event::PortFactory<ipc::Service>;
+
+/// Something a [`crate::Waiter`] can wait on: a subscriber with its event service.
+pub trait Wakeable {
+    /// Name of the service (for errors and logs).
+    fn service_name(&self) -> &str;
+    /// The event service notified after every send on the topic.
+    #[doc(hidden)]
+    fn event_factory(&self) -> &EventFactory;
+}
 
 /// Why [`Waiter::wait`] returned.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,7 +1,9 @@
 //! zenoh -> iceoryx2 worker.
 
+use super::counters::Counters;
 use super::limiter::Limiter;
-use super::{Counters, Route, Run, STOP_POLL};
+use super::route::Route;
+use super::worker::{Run, STOP_POLL};
 use crate::cloud::CloudPublisher;
 use crate::error::BusError;
 use crate::node::Bus;

@@ -1,7 +1,9 @@
 //! iceoryx2 -> zenoh worker.
 
+use super::counters::Counters;
 use super::limiter::Limiter;
-use super::{Counters, Route, Run, STOP_POLL};
+use super::route::Route;
+use super::worker::{Run, STOP_POLL};
 use crate::cloud::CloudSubscriber;
 use crate::error::BusError;
 use crate::node::Bus;

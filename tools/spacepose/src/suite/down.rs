@@ -1,7 +1,6 @@
 //! `spacepose down`: stop a deployment and clean up after it.
 
-use super::launch::STOP_GRACE;
-use super::process::terminate;
+use super::process::{STOP_GRACE, terminate};
 use super::state::RunState;
 use anyhow::{Context, Result};
 use spacepose_bus::{cleanup_dead_nodes, iceoryx2_config};

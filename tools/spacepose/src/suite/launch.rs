@@ -12,8 +12,7 @@ use std::path::PathBuf;
 use std::process::Child;
 use std::time::{Duration, Instant};
 
-/// How long a service gets to stop after SIGTERM before SIGKILL.
-pub const STOP_GRACE: Duration = Duration::from_secs(5);
+pub use super::process::STOP_GRACE;
 
 /// A deployment started by this process.
 #[derive(Debug)]
@@ -84,7 +83,7 @@ pub fn start(plan: &Plan, watch: &mut HealthWatch, out: &mut dyn Write) -> Resul
             started_unix_s: unix_now_s(),
             started_by_pid: std::process::id(),
             supervisor_pid: None,
-            primary: super::supervisor::configured_primary(plan),
+            primary: super::plan::configured_primary(plan),
             instances: Vec::new(),
         },
         children: Vec::new(),

@@ -66,6 +66,9 @@ pub fn signal_group(pid: u32, signal: Signal) {
     }
 }
 
+/// How long a service gets to stop after SIGTERM before SIGKILL.
+pub const STOP_GRACE: Duration = Duration::from_secs(5);
+
 /// Sends SIGTERM to each live process of `procs` (pid, binary), waits up
 /// to `grace` for them to exit (reaping through `reap`), then SIGKILLs the
 /// stragglers. Returns the names of the processes that had to be killed.

@@ -13,11 +13,10 @@ use super::health::HealthWatch;
 use super::launch::RunningSuite;
 use super::plan::{Plan, PlannedInstance};
 use super::restart::RestartHistory;
-use super::swap::{SwapJob, SwapReport, SwapRequest};
+use super::swap::{SwapJob, SwapReport};
 use anyhow::Result;
 use iceoryx2::node::NodeView;
 use iceoryx2::prelude::*;
-use rustix::process::Signal;
 use spacepose_bus::{Bus, Publisher, Subscriber, cleanup_dead_nodes, iceoryx2_config};
 use spacepose_messages::ServiceKind;
 use spacepose_messages::{Command, Names, PoseEstimate};
@@ -25,20 +24,12 @@ use std::collections::BTreeMap;
 use std::io::Write;
 use std::time::{Duration, Instant};
 
+pub use super::plan::configured_primary;
+
 /// How often dead iceoryx2 nodes are looked for.
 const DEAD_NODE_SCAN: Duration = Duration::from_millis(250);
 /// How often `state.json` is rewritten when nothing changed.
 const STATE_SAVE: Duration = Duration::from_millis(500);
-
-/// The filter's configured primary tracker (`primary` in its config).
-pub fn configured_primary(plan: &Plan) -> Option<String> {
-    plan.instances
-        .iter()
-        .find(|i| i.kind == ServiceKind::Filter)
-        .and_then(|f| f.config.get("primary"))
-        .and_then(toml::Value::as_str)
-        .map(str::to_string)
-}
 
 /// A detected fault and what the supervisor did about it.
 #[derive(Debug, Clone)]
@@ -279,118 +270,6 @@ impl Supervisor {
         self.suite.state.primary = primary;
     }
 
-    /// Queues a swap (one at a time).
-    pub fn request_swap(&mut self, req: SwapRequest, out: &mut dyn Write) -> Result<()> {
-        if self.swap.is_some() {
-            anyhow::bail!("a swap is already running");
-        }
-        self.swap_count += 1;
-        let job = SwapJob::start(self, req, self.swap_count, out)?;
-        self.swap = Some(job);
-        Ok(())
-    }
-
-    /// True while a swap runs.
-    pub fn swapping(&self) -> bool {
-        self.swap.is_some()
-    }
-
-    fn step_swap(&mut self, poses: &[PoseEstimate], out: &mut dyn Write) -> Result<()> {
-        let Some(mut job) = self.swap.take() else {
-            return Ok(());
-        };
-        match job.step(self, poses, out) {
-            Ok(Some(report)) => {
-                writeln!(out, "supervisor: {}", report.line())?;
-                self.swaps.push(report);
-                self.save_state()?;
-            }
-            Ok(None) => self.swap = Some(job),
-            Err(e) => {
-                let report = job.fail(self, &format!("{e:#}"));
-                writeln!(out, "supervisor: swap failed: {e:#}")?;
-                self.swaps.push(report);
-            }
-        }
-        Ok(())
-    }
-
-    // --- used by the swap job ---
-
-    /// Starts a new instance (not in the original plan).
-    pub(crate) fn add_instance(&mut self, planned: PlannedInstance) -> Result<u32> {
-        let pid = self.suite.spawn_instance(&self.plan, &planned)?;
-        self.records.insert(
-            planned.name.clone(),
-            Record {
-                started_at: Some(Instant::now()),
-                ..Record::default()
-            },
-        );
-        self.plan.instances.retain(|i| i.name != planned.name);
-        self.plan.instances.push(planned);
-        self.save_state()?;
-        Ok(pid)
-    }
-
-    /// Stops an instance on purpose (SIGTERM; its exit is no fault).
-    pub(crate) fn retire(&mut self, name: &str) {
-        if let Some(r) = self.records.get_mut(name) {
-            r.retiring = true;
-            r.restart_at = None;
-            // A left-down instance's exit is handled again, as retiring.
-            r.down = false;
-        }
-        self.plan.instances.retain(|i| i.name != name);
-        // An exited process's group id may belong to another process now.
-        if self.suite.try_exit(name).is_none() {
-            self.suite.signal(name, Signal::TERM);
-        }
-    }
-
-    /// True once `name` has exited and been forgotten.
-    pub(crate) fn is_gone(&self, name: &str) -> bool {
-        self.suite.index(name).is_none()
-    }
-
-    /// Makes `name` the filter's primary: the swap command, and the filter's
-    /// config for its restarts.
-    pub(crate) fn set_primary(&mut self, name: &str) -> Result<()> {
-        let mut c = Command::new(
-            spacepose_messages::CommandKind::Swap,
-            spacepose_messages::Name::new("supervisor")?,
-        );
-        c.target_instance = spacepose_messages::Name::new(name)?;
-        self.commands.send(&c)?;
-        for f in self
-            .plan
-            .instances
-            .iter_mut()
-            .filter(|i| i.kind == ServiceKind::Filter)
-        {
-            f.config
-                .insert("primary".into(), toml::Value::String(name.to_string()));
-        }
-        self.primary = Some(name.to_string());
-        self.save_state()
-    }
-
-    /// The primary, or the only instance, of `kind`.
-    pub(crate) fn active_instance(&self, kind: ServiceKind) -> Option<String> {
-        let of_kind: Vec<&str> = self
-            .suite
-            .state
-            .instances
-            .iter()
-            .filter(|i| i.kind == kind)
-            .map(|i| i.name.as_str())
-            .collect();
-        match &self.primary {
-            Some(p) if of_kind.contains(&p.as_str()) => Some(p.clone()),
-            _ => of_kind.first().map(|s| s.to_string()),
-        }
-    }
-
     /// Stops everything (see [`RunningSuite::stop`]).
     pub fn stop(self, out: &mut dyn Write) -> Result<()> {
         let Supervisor {
@@ -407,6 +286,7 @@ impl Supervisor {
 }
 
 mod faults;
+mod swaps;
 
 #[cfg(test)]
 #[path = "supervisor_tests.rs"]

@@ -8,6 +8,8 @@ use crate::suite::launch::RunningSuite;
 use crate::suite::process::{is_alive, signal_group};
 use crate::suite::restart::{Policy, RestartSettings};
 use crate::suite::state::{RunState, run_dir, unix_now_s};
+use crate::suite::swap::SwapHost;
+use rustix::process::Signal;
 use std::path::{Path, PathBuf};
 
 /// Delay of every first restart of the test suites.

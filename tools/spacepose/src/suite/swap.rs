@@ -12,7 +12,6 @@
 //! to a standby at the frame deadline anyway: no frame goes without a pose.
 
 use super::plan::PlannedInstance;
-use super::supervisor::Supervisor;
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
 use spacepose_messages::ServiceKind;
@@ -67,6 +66,26 @@ impl SwapReport {
     }
 }
 
+/// What a swap job does to the suite it runs in: the supervisor
+/// implements it (`supervisor/swaps.rs`).
+pub trait SwapHost {
+    /// Starts a new instance (not in the original plan).
+    fn add_instance(&mut self, planned: PlannedInstance) -> Result<u32>;
+    /// Stops an instance on purpose (SIGTERM; its exit is no fault).
+    fn retire(&mut self, name: &str);
+    /// True once `name` has exited and been forgotten.
+    fn is_gone(&self, name: &str) -> bool;
+    /// Makes `name` the filter's primary: the swap command, and the filter's
+    /// config for its restarts.
+    fn set_primary(&mut self, name: &str) -> Result<()>;
+    /// The primary, or the only instance, of `kind`.
+    fn active_instance(&self, kind: ServiceKind) -> Option<String>;
+    /// The planned instance `name`.
+    fn planned(&self, name: &str) -> Option<&PlannedInstance>;
+    /// The filter's primary tracker.
+    fn primary(&self) -> Option<&str>;
+}
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Phase {
     Warming,
@@ -74,7 +93,7 @@ enum Phase {
     Stopping,
 }
 
-/// A swap in progress, driven by [`Supervisor::step`].
+/// A swap in progress, driven by [`super::supervisor::Supervisor::step`].
 #[derive(Debug)]
 pub struct SwapJob {
     old: String,
@@ -112,7 +131,7 @@ pub fn swapped_config(old: &toml::Table, mode: Option<&str>) -> Result<toml::Tab
 impl SwapJob {
     /// Starts the new instance.
     pub fn start(
-        sup: &mut Supervisor,
+        sup: &mut impl SwapHost,
         req: SwapRequest,
         n: u32,
         out: &mut dyn Write,
@@ -128,7 +147,7 @@ impl SwapJob {
             .cloned()
             .with_context(|| format!("{old} is not in the plan"))?;
         let mut new = format!("{}-s{n}", req.kind);
-        while sup.suite.index(&new).is_some() {
+        while !sup.is_gone(&new) {
             new.push('x');
         }
         let config = swapped_config(&planned.config, req.mode.as_deref())?;
@@ -164,7 +183,7 @@ impl SwapJob {
     /// Advances the swap; `Some(report)` when it is over.
     pub fn step(
         &mut self,
-        sup: &mut Supervisor,
+        sup: &mut impl SwapHost,
         poses: &[PoseEstimate],
         out: &mut dyn Write,
     ) -> Result<Option<SwapReport>> {
@@ -218,11 +237,11 @@ impl SwapJob {
     }
 
     /// Gives up: the new instance is stopped; the old one stays (primary again).
-    pub fn fail(&self, sup: &mut Supervisor, why: &str) -> SwapReport {
+    pub fn fail(&self, sup: &mut impl SwapHost, why: &str) -> SwapReport {
         if !sup.is_gone(&self.new) {
             sup.retire(&self.new);
         }
-        if sup.primary.as_deref() == Some(self.new.as_str()) && !sup.is_gone(&self.old) {
+        if sup.primary() == Some(self.new.as_str()) && !sup.is_gone(&self.old) {
             let _ = sup.set_primary(&self.old);
         }
         self.report(Some(why.to_string()))
