@@ -3,7 +3,7 @@
 Subscribes to the JSON telemetry of one deployment over zenoh and prints one
 line per pose (or every sample with --all), optionally appending every sample
 to a JSON-lines file. The schema of each key is in
-services/telemetry/TELEMETRY.md.
+docs/telemetry.md.
 
     pip install -r tools/ground/requirements.txt
     python tools/ground/listen.py --connect tcp/127.0.0.1:7447 --prefix demo --count 20

@@ -19,7 +19,7 @@
 //! usrpwd proves the user by an HMAC of its password over a random nonce
 //! (the password never crosses the link), but the link itself stays
 //! unencrypted TCP: over an untrusted network use TLS or a VPN as well
-//! (`deploy/SECURITY.md`).
+//! (`docs/security.md`).
 //!
 //! A consequence of usrpwd in zenoh 1.10: a listener with a user dictionary
 //! refuses the handshake of any peer that presents no credentials, so an

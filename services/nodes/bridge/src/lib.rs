@@ -16,7 +16,7 @@
 //! - Access: a host that listens requires a `peers` account of the link
 //!   dictionary from every host that connects (usrpwd) and enforces an ACL
 //!   by user name (default deny); a host that connects presents its account
-//!   (`credentials_file`). See `deploy/SECURITY.md`.
+//!   (`credentials_file`). See `docs/security.md`.
 //!
 //! The library holds the configuration and its checks, the link the node
 //! asks the runtime for ([`link_spec`]: session, access, account, routes,

@@ -74,7 +74,7 @@ impl Default for Rates {
 /// Access control of the ground link (`[access]`): usrpwd authentication of
 /// every connecting peer and an ACL by username, default deny. The node
 /// hands it to the runtime's link as the bus's `AccessControl` (policy and reasons documented
-/// there and in `deploy/SECURITY.md`). Absent = no authentication: keep the
+/// there and in `docs/security.md`). Absent = no authentication: keep the
 /// default loopback endpoints then.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

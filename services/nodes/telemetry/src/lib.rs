@@ -11,7 +11,7 @@
 //!
 //! Keys (below `spacepose/{prefix}/telemetry/`): `pose`, `filter`,
 //! `health/<instance>`, `truth`, `errors`, and the queryable `latest`. The
-//! schema is documented in `TELEMETRY.md` and on the types.
+//! schema is documented in `docs/telemetry.md` and on the types.
 //!
 //! The link also carries the ground -> suite command path: a route forwards
 //! postcard `Command`s from `spacepose/{prefix}/wire/command` to the bus;
@@ -25,7 +25,7 @@
 //! anyone who reaches the endpoints may command the suite: the endpoints are
 //! loopback by default, and listening elsewhere without `[access]` is
 //! warned about. Why usernames (not TLS certificates, interfaces or zenoh
-//! ids): `spacepose_bus::zenoh_access` and `deploy/SECURITY.md`.
+//! ids): `spacepose_bus::zenoh_access` and `docs/security.md`.
 #![forbid(unsafe_code)]
 
 pub mod commands;

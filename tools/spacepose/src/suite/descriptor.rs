@@ -104,7 +104,7 @@ pub struct LinkSettings {
     /// only the `peers` accounts (ACL by user name, default deny).
     /// Relative to the descriptor's directory. None: no access control.
     pub dictionary_file: Option<PathBuf>,
-    /// The hosts' accounts (the `peers` role of deploy/SECURITY.md).
+    /// The hosts' accounts (the `peers` role of docs/security.md).
     pub peers: Vec<String>,
     /// Largest rate of clouds over the link (Hz); None: every frame.
     pub cloud_rate_hz: Option<f64>,
