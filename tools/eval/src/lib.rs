@@ -18,6 +18,7 @@ pub mod plot;
 pub mod sim;
 pub mod stats;
 pub mod table;
+pub mod tables;
 pub mod tm;
 pub mod tracking;
 pub mod truth_csv;

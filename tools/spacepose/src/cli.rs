@@ -170,4 +170,7 @@ pub enum EvalCommand {
     Cnn(spacepose_eval::cnn::EvalCnnArgs),
     /// Template-matching acquisition (seed 002 §4): success rate, time, f_CONV.
     Tm(spacepose_eval::tm::EvalTmArgs),
+    /// Regenerate (or --check) the results tables of the README and docs/
+    /// from the committed runs under docs/results/.
+    Tables(spacepose_eval::tables::TablesArgs),
 }
