@@ -108,15 +108,18 @@ fn run_suite() -> BTreeMap<u64, PoseEstimate> {
     let prefix = unique_prefix("fpath");
     let _down = DownOnDrop(prefix.clone());
     let deploy = descriptor(&dir);
-    let names = Names::new(&prefix).unwrap();
-    let bus = Bus::open(&names, "e2e-frame-path").unwrap();
-    let poses = bus.subscriber::<PoseEstimate>(&names.pose()).unwrap();
-    let up = spacepose(&["up", deploy.to_str().unwrap(), "--prefix", &prefix]);
+    let names = Names::new(&prefix).expect("a valid prefix");
+    let bus = Bus::open(&names, "e2e-frame-path").expect("opening the bus");
+    let poses = bus
+        .subscriber::<PoseEstimate>(&names.pose())
+        .expect("subscribing to the poses");
+    let deploy = deploy.to_str().expect("a UTF-8 path");
+    let up = spacepose(&["up", deploy, "--prefix", &prefix]);
     assert!(up.status.success(), "{}", text(&up));
     let mut seen = BTreeMap::new();
     let deadline = Instant::now() + Duration::from_secs(120);
     while !seen.contains_key(&(FRAMES - 1)) {
-        while let Some(p) = poses.try_recv().unwrap() {
+        while let Some(p) = poses.try_recv().expect("receiving poses") {
             seen.entry(p.sequence).or_insert(p);
         }
         assert!(Instant::now() < deadline, "timed out: {:?}", seen.keys());

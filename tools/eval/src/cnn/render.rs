@@ -2,12 +2,12 @@
 //! f_CONV check, success by range and the per-frame table that
 //! [`super::cnn::print`] prints.
 
-use super::{CnnFrame, CnnReport, FconvStats, MeanStd, RangeBin, TimeSplit};
+use super::report::{CnnFrame, CnnReport, FconvStats, MeanStd, RangeBin, TimeSplit};
 use crate::table::{Table, num, sci};
 
 /// The first line: the run, the mean points, the estimator errors, the
 /// hypotheses and the twin check.
-pub(super) fn summary_line(report: &CnnReport) -> String {
+pub fn summary_line(report: &CnnReport) -> String {
     format!(
         "CNN pose estimation, {} held-out frames (seed {}), target {}, model {}, engine {} (one thread); \
          mean {:.0} points per frame; {} estimator errors; {} frames refined several \
@@ -40,7 +40,7 @@ fn mean_std(m: MeanStd, decimals: usize) -> String {
 }
 
 /// Table III: success and errors before and after refinement.
-pub(super) fn table3(report: &CnnReport) -> Table {
+pub fn table3(report: &CnnReport) -> Table {
     let mut t3 = Table::new(&[
         "step",
         "success [%]",
@@ -63,7 +63,7 @@ pub(super) fn table3(report: &CnnReport) -> Table {
 }
 
 /// Table IV: the time of each step.
-pub(super) fn table4(t: &TimeSplit) -> Table {
+pub fn table4(t: &TimeSplit) -> Table {
     let mut t4 = Table::new(&["step", "median [ms]", "mean ± std [ms]", "p95 [ms]"]);
     for (name, s) in [
         ("preprocessing", t.preprocess),
@@ -82,7 +82,7 @@ pub(super) fn table4(t: &TimeSplit) -> Table {
 }
 
 /// The f_CONV acceptance check in one line.
-pub(super) fn fconv_line(f: &FconvStats) -> String {
+pub fn fconv_line(f: &FconvStats) -> String {
     format!(
         "f_CONV check (f_MAX {} m²): accepted {}%, false accepts {}, false rejects {}; \
          successes max {} median {} m², failures min {} median {} m²",
@@ -98,7 +98,7 @@ pub(super) fn fconv_line(f: &FconvStats) -> String {
 }
 
 /// Success by range.
-pub(super) fn range_table(bins: &[RangeBin]) -> Table {
+pub fn range_table(bins: &[RangeBin]) -> Table {
     let mut t = Table::new(&["range [m]", "frames", "raw [%]", "refined [%]"]);
     for b in bins {
         t.row(vec![
@@ -112,7 +112,7 @@ pub(super) fn range_table(bins: &[RangeBin]) -> Table {
 }
 
 /// The per-frame table.
-pub(super) fn frames_table(frames: &[CnnFrame]) -> Table {
+pub fn frames_table(frames: &[CnnFrame]) -> Table {
     let mut all = Table::new(&[
         "frame", "range", "points", "raw deg", "raw cm", "deg", "cm", "f_conv", "expl", "twin",
         "ok", "ms",

@@ -1,14 +1,15 @@
 //! Text of the `eval tm` report: the header line, the summary table and the
 //! per-frame table that [`super::tm::render`] puts together.
 
-use super::{SensorEffects, TmFrame, TmReport};
+use super::args::SensorEffects;
+use super::report::{TmFrame, TmReport};
 use crate::table::{Table, num, sci};
 use spacepose_acquisition::{TemplateMatchingConfig, Threads};
 use std::fmt::Display;
 
 /// The first line: target, scenario, seed, sensor effects, frames and the
 /// matching settings, newline included.
-pub(super) fn header(report: &TmReport) -> String {
+pub fn header(report: &TmReport) -> String {
     let c = &report.config;
     format!(
         "template matching: {} / {}{} / seed {}{} / {} frames / Δ {}° {}/ {} / {}{} refined, mean {:.0} points\n",
@@ -87,7 +88,7 @@ fn rerank_label(c: &TemplateMatchingConfig) -> String {
 }
 
 /// The summary table (figure, value).
-pub(super) fn summary_table(report: &TmReport) -> Table {
+pub fn summary_table(report: &TmReport) -> Table {
     let mut t = Table::new(&["figure", "value"]);
     outcome_rows(&mut t, report);
     accuracy_rows(&mut t, report);
@@ -209,7 +210,7 @@ fn fconv_rows(t: &mut Table, report: &TmReport) {
 }
 
 /// The per-frame table.
-pub(super) fn frames_table(frames: &[TmFrame]) -> Table {
+pub fn frames_table(frames: &[TmFrame]) -> Table {
     let mut f = Table::new(&[
         "frame",
         "range m",

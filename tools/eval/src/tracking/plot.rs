@@ -8,7 +8,7 @@ use std::path::Path;
 
 /// Plots the errors of every mode of `report` to `path` (`.png` or `.svg`)
 /// and says so.
-pub(super) fn write_plot(path: &Path, report: &TrackingReport) -> Result<()> {
+pub fn write_plot(path: &Path, report: &TrackingReport) -> Result<()> {
     let columns: Vec<Columns> = report
         .modes
         .iter()
