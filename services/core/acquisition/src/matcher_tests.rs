@@ -1,8 +1,13 @@
+use super::scoring::Sensed;
 use super::*;
+use crate::config::Threads;
+use crate::correlation::{Centering, Correlator, d_bor, d_bor_passes};
+use crate::refine::refine_with_stages;
 use crate::template::TemplateRenderer;
 use spacepose_geometry::so3;
 use spacepose_lidar_sim::Effects;
 use spacepose_scenario::TruthState;
+use std::f64::consts::PI;
 use std::sync::OnceLock;
 
 fn envisat() -> Arc<Target> {

@@ -22,12 +22,16 @@ use spacepose_inference::{Engine, ModelShape, PoseNet};
 use spacepose_model::Target;
 
 use crate::classes::{ClassTable, DEFAULT_ROLL_STEP_DEG};
-use crate::decode::{DEFAULT_DELTA_BETA_DEG, decode, decode_around, modes};
+use crate::decode::{DEFAULT_DELTA_BETA_DEG, decode};
 use crate::error::CnnError;
 use crate::model_meta::{ModelMeta, model_onnx_path};
 use crate::preprocess::{DepthImage, PreprocessConfig, preprocess};
-use crate::refinement::{Refined, RefinementConfig, Refiner, ms};
-use crate::twins::{TwinCheckConfig, TwinOutcome, check_twins};
+use crate::refinement::{RefinementConfig, Refiner, ms};
+use crate::twins::{TwinCheckConfig, TwinOutcome};
+
+mod estimate;
+mod hypotheses;
+pub use estimate::{CnnEstimate, Timings};
 
 /// Fewer finite points than this is an error, never an estimate.
 pub const MIN_POINTS: usize = 20;
@@ -70,57 +74,6 @@ impl Default for EstimatorConfig {
     }
 }
 
-/// Run time of one estimate, split as seed 004 Table IV (ms).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
-pub struct Timings {
-    /// Finite-point filter, trimmed centroid and depth image.
-    pub preprocess: f64,
-    /// Network and Γ_sym decoding.
-    pub inference: f64,
-    /// Voxel filter, NDT, the f_CONV ICP and the twin check.
-    pub refinement: f64,
-    /// Everything.
-    pub total: f64,
-}
-
-/// One estimate.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct CnnEstimate {
-    /// The network's pose (Γ_sym attitude, ROI centre + offset).
-    pub t_sensor_target_raw: Pose,
-    /// The NDT-refined pose; the raw pose when the refinement failed.
-    pub t_sensor_target: Pose,
-    /// f_CONV (m²); infinite when the refinement failed.
-    pub f_conv_m2: f64,
-    /// `f_CONV <= f_MAX`: the pose may be used.
-    pub accepted: bool,
-    /// The twin check of the refined pose (default when the refinement
-    /// failed).
-    pub twins: TwinOutcome,
-    /// Class of largest probability.
-    pub top_class: usize,
-    /// Its probability.
-    pub top_probability: f32,
-    /// Finite points of the cloud.
-    pub points: usize,
-    /// Points inside the ROI.
-    pub points_in_roi: usize,
-    /// Which hypothesis the reported pose comes from (0 = Γ_sym's).
-    pub hypothesis: usize,
-    /// Hypotheses refined.
-    pub hypotheses_refined: usize,
-    /// NDT iterations (all stages) of the reported hypothesis.
-    pub ndt_iterations: usize,
-    /// The final NDT stage converged.
-    pub ndt_converged: bool,
-    /// Why the refinement failed, if it did.
-    pub refinement_error: Option<String>,
-    /// Run time split.
-    pub time_ms: Timings,
-    /// Of the refinement: the f_CONV ICP (ms).
-    pub fconv_ms: f64,
-}
-
 /// The network's pose of one frame (§III.B, §III.D), decoded.
 struct NetworkPose {
     /// Γ_sym's attitude (Algorithm 1) at the ROI centre plus the offset.
@@ -133,17 +86,6 @@ struct NetworkPose {
     top_class: usize,
     /// Its probability.
     top_probability: f32,
-}
-
-/// The refinement of the attitude hypotheses of one frame.
-struct Hypotheses {
-    /// The hypothesis index and refinement with the lowest f_CONV (the
-    /// first accepted one).
-    best: Option<(usize, Refined)>,
-    /// Hypotheses refined.
-    tried: usize,
-    /// The first refinement error, if any.
-    error: Option<String>,
 }
 
 /// A loaded network with its class table, preprocessing and refinement
@@ -318,94 +260,6 @@ impl CnnEstimator {
             top_class,
             top_probability,
         })
-    }
-
-    /// Refines the attitude hypotheses of `net` on `cloud` (§III.E, with
-    /// the f_CONV check), then runs the twin check on the best refinement
-    /// (which it may replace); the default outcome when none succeeded.
-    fn refine_and_check_twins(
-        &self,
-        cloud: &[Point],
-        net: &NetworkPose,
-    ) -> (Hypotheses, TwinOutcome) {
-        let mut refined = self.refine_hypotheses(cloud, &net.raw, &net.probs, net.delta_beta);
-        let mut twins = TwinOutcome::default();
-        if let Some((h, r)) = refined.best.take() {
-            let (r, outcome) = check_twins(&self.refiner, cloud, r, &self.config.twins);
-            refined.best = Some((h, r));
-            twins = outcome;
-        }
-        (refined, twins)
-    }
-
-    /// Puts the best refinement of `refined` in `estimate` (with its
-    /// f_CONV check), or, none having succeeded, the first refinement error.
-    fn report_refinement(&self, estimate: &mut CnnEstimate, refined: Hypotheses) {
-        match refined.best {
-            Some((h, r)) => {
-                estimate.t_sensor_target = r.t_sensor_target;
-                estimate.f_conv_m2 = r.f_conv_m2;
-                estimate.accepted = self.refiner.accepts(r.f_conv_m2);
-                estimate.hypothesis = h;
-                estimate.ndt_iterations = r.ndt_iterations;
-                estimate.ndt_converged = r.ndt_converged;
-                estimate.fconv_ms = r.fconv_ms;
-            }
-            None => estimate.refinement_error = refined.error,
-        }
-    }
-
-    /// Refines Γ_sym's pose, then the other modes of `probs` (same position)
-    /// until one passes the f_CONV check; keeps the lowest f_CONV.
-    fn refine_hypotheses(
-        &self,
-        cloud: &[Point],
-        raw: &Pose,
-        probs: &[f32],
-        delta_beta: f64,
-    ) -> Hypotheses {
-        let mut result = Hypotheses {
-            best: None,
-            tried: 0,
-            error: None,
-        };
-        let modes = if self.config.hypotheses > 1 {
-            modes(&self.classes, probs, self.config.hypotheses, delta_beta)
-        } else {
-            Vec::new()
-        };
-        let rotations = std::iter::once(raw.rotation).chain(
-            modes
-                .into_iter()
-                .skip(1)
-                .map(|i| decode_around(&self.classes, probs, i, delta_beta)),
-        );
-        for (h, rotation) in rotations.enumerate() {
-            result.tried += 1;
-            let pose = Pose {
-                rotation,
-                translation: raw.translation,
-            };
-            match self.refiner.refine(cloud, &pose) {
-                Ok(r) => {
-                    let accepted = self.refiner.accepts(r.f_conv_m2);
-                    if result
-                        .best
-                        .as_ref()
-                        .is_none_or(|(_, b)| r.f_conv_m2 < b.f_conv_m2)
-                    {
-                        result.best = Some((h, r));
-                    }
-                    if accepted {
-                        break;
-                    }
-                }
-                Err(e) => {
-                    result.error.get_or_insert(e.to_string());
-                }
-            }
-        }
-        result
     }
 
     /// The class table.

@@ -26,11 +26,13 @@ pub mod error;
 pub mod filter;
 pub mod kalman;
 pub mod motion_compensation;
+mod outputs;
 pub mod position;
 
 pub use attitude::AttitudeFilter;
 pub use config::FilterConfig;
 pub use error::FilterError;
-pub use filter::{Prediction, RelativeMotionFilter, UpdateOutcome, covariance_from_information};
+pub use filter::{RelativeMotionFilter, covariance_from_information};
 pub use motion_compensation::MotionCompensation;
+pub use outputs::{Prediction, UpdateOutcome};
 pub use position::PositionFilter;

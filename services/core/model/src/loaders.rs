@@ -9,6 +9,8 @@
 //!
 //! Polygons (OBJ, PLY) are split into triangle fans. OBJ materials (`mtllib`) are ignored;
 //! points and lines are skipped.
+//!
+//! [`Material::default_structure`]: crate::material::Material::default_structure
 
 use std::fs::File;
 use std::io::BufReader;
@@ -19,16 +21,15 @@ use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Property};
 
 use crate::error::TargetError;
-use crate::material::Material;
 use crate::mesh::Mesh;
-use crate::target::Target;
 
 /// Raw vertices (file units) and triangles.
 type RawMesh = (Vec<Vector3<f64>>, Vec<[u32; 3]>);
 
-/// Reads `path` (extension decides the format), applies `scale`, recentres on the
-/// area-weighted centroid and wraps the mesh in a [`Target`] named after the file stem.
-pub(crate) fn load_target(path: &Path, scale: f64) -> Result<Target, TargetError> {
+/// Reads `path` (extension decides the format), applies `scale` and recentres on the
+/// area-weighted centroid. Returns the mesh with its name (the file stem); `Target::load`
+/// wraps it in a target.
+pub(crate) fn load_mesh(path: &Path, scale: f64) -> Result<(String, Mesh), TargetError> {
     if !(scale.is_finite() && scale > 0.0) {
         return Err(TargetError::InvalidScale {
             spec: path.display().to_string(),
@@ -66,12 +67,7 @@ pub(crate) fn load_target(path: &Path, scale: f64) -> Result<Target, TargetError
     let name = path
         .file_stem()
         .map_or_else(|| "mesh".to_owned(), |s| s.to_string_lossy().into_owned());
-    Target::new(
-        &name,
-        mesh,
-        vec![Material::default_structure()],
-        vec![Rotation3::identity()],
-    )
+    Ok((name, mesh))
 }
 
 fn read_error(path: &Path, message: impl std::fmt::Display) -> TargetError {

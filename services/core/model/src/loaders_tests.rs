@@ -1,4 +1,6 @@
 use super::*;
+use crate::material::Material;
+use crate::target::Target;
 use std::io::Write;
 
 /// Cube of side 2 (file units) centred at CENTER: 8 corners and 6 outward quads.

@@ -114,7 +114,13 @@ impl Target {
     /// loaded target. The whole mesh gets one material ([`Material::default_structure`]:
     /// structure, ρ = 0.6) and the symmetry group is the identity alone.
     pub fn load(path: &Path, scale: f64) -> Result<Target, TargetError> {
-        loaders::load_target(path, scale)
+        let (name, mesh) = loaders::load_mesh(path, scale)?;
+        Target::new(
+            &name,
+            mesh,
+            vec![Material::default_structure()],
+            vec![Rotation3::identity()],
+        )
     }
 
     /// A built-in target if `spec` is one of [`Target::BUILTIN`], otherwise a mesh file path

@@ -25,6 +25,7 @@ pub mod config;
 mod dispatch;
 pub mod error;
 pub mod held_rotation;
+mod loss;
 pub mod measurement;
 pub mod mode;
 pub mod model;

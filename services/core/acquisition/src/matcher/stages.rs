@@ -3,7 +3,8 @@
 //! ICP refinement of the candidates with the second chance, and the
 //! outcome with the f_CONV check (§4.5).
 
-use super::{Ranked, Sensed, TemplateMatcher, ms_since};
+use super::scoring::{Ranked, Sensed};
+use super::{TemplateMatcher, ms_since};
 use crate::correlation::{Centering, Correlator, d_bor};
 use crate::error::AcquisitionError;
 use crate::outcome::AcquisitionOutcome;
@@ -153,6 +154,34 @@ impl Refinements {
 }
 
 impl TemplateMatcher {
+    /// Acquires the pose of the target in `cloud` (one frame, sensor
+    /// frame): template matching, ICP refinement of the best candidates,
+    /// f_CONV check. Non-finite points are ignored.
+    ///
+    /// Errors: [`AcquisitionError::TooFewPoints`] for a cloud with fewer
+    /// than `min_points` finite points (sparse or all-NaN: never a pose);
+    /// [`AcquisitionError::NoTemplate`] when no template could be
+    /// correlated. A failed refinement is not an error: the outcome is then
+    /// not accepted.
+    pub fn acquire(&self, cloud: &[Point]) -> Result<AcquisitionOutcome, AcquisitionError> {
+        let start = Instant::now();
+        let frame = self.prepare(cloud)?;
+        let matched = self.match_frame(&frame)?;
+        let matching_ms = ms_since(start);
+
+        // Template solution(s): grid attitude, origin from the centroid alignment.
+        let refine_start = Instant::now();
+        let sensed_tree = SensedTree::new(&frame.positions);
+        let mut refinements = self.refine_candidates(&matched.ranked, &frame, &sensed_tree);
+        self.add_second_chance(&mut refinements, &frame, &sensed_tree);
+        let timing = Timing {
+            start,
+            matching_ms,
+            refinement_ms: ms_since(refine_start),
+        };
+        Ok(self.outcome(&frame, &matched, &refinements, timing))
+    }
+
     /// The finite points of `cloud`, their positions and centre.
     /// [`AcquisitionError::TooFewPoints`] with fewer than `min_points`
     /// finite points, or when the centre cannot be taken (`valid: 0`).

@@ -17,10 +17,11 @@
 //! The reported information is that of `T^e` with `T^s` marginalised out
 //! (Schur complement), the reported cost that of the points alone.
 
-use super::ScanTimes;
 use super::displacement_prior::DisplacementPrior;
+use super::interpolation::ScanTimes;
 use super::joint::{Joint, TimedPoint, linearise, split};
 use super::rate_prior::RatePrior;
+use super::start_prior::StartPrior;
 use crate::degeneracy::constrained_directions;
 use crate::error::RegistrationError;
 use crate::ndt_map::NdtMap;
@@ -28,41 +29,13 @@ use crate::normal_equations::{Constrained, increment_of};
 use crate::params::NdtParams;
 use crate::result::{Cost, Increment, Registration};
 use crate::source::{check_pose, position_is_finite};
-use nalgebra::{DMatrix, Matrix6};
+use nalgebra::DMatrix;
 use spacepose_geometry::{Point, Pose};
 
 /// Termination tolerance of the start pose's increment, in multiples of
 /// the end pose's thresholds (`termination_rotation_deg`,
 /// `termination_translation_m`).
 const START_TOLERANCE: f64 = 5.0;
-
-/// A Gaussian prior on the start pose `T^s = t_target_sensor` of a scan.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StartPrior {
-    /// Mean of `T^s`.
-    pub t_target_sensor: Pose,
-    /// Information (inverse covariance) of a left perturbation
-    /// `δ = [rot; trans]` of the mean (seed 000 Eq. 5); symmetric positive
-    /// semi-definite, in the units of the NDT information (Eq. 7).
-    pub information: Matrix6<f64>,
-}
-
-impl StartPrior {
-    /// Rejects a non-finite mean or information, or a negative diagonal.
-    pub fn validate(&self) -> Result<(), RegistrationError> {
-        check_pose("start prior", &self.t_target_sensor)?;
-        let ok = self.information.iter().all(|v| v.is_finite())
-            && self.information.diagonal().iter().all(|&d| d >= 0.0);
-        if ok {
-            Ok(())
-        } else {
-            Err(RegistrationError::param(
-                "start_prior.information",
-                "need a finite matrix with a non-negative diagonal",
-            ))
-        }
-    }
-}
 
 /// The outcome of [`register_ct_ndt_free_start`].
 #[derive(Debug, Clone, PartialEq)]

@@ -1,11 +1,10 @@
 use super::*;
+use crate::ct_ndt::interpolation::{Interpolation, exp_coefficients};
 use crate::ct_ndt::joint::{Matrix12, Vector12};
-use crate::ct_ndt::{
-    Interpolation, ct_point_jacobian, exp_coefficients, interpolate, register_ct_ndt,
-};
+use crate::ct_ndt::{ct_point_jacobian, interpolate, register_ct_ndt};
 use crate::test_support::{map, perturb, rng, target, true_t_sensor_target};
 use nalgebra::Matrix3x6;
-use nalgebra::{Matrix3, SMatrix, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix6, SMatrix, Vector3, Vector6};
 use rand::RngExt;
 use spacepose_geometry::so3;
 

@@ -4,9 +4,9 @@
 //! ends), the Gaussian priors, and the solve.
 
 use super::displacement_prior::DisplacementPrior;
-use super::free_start::StartPrior;
+use super::interpolation::{Interpolation, exp_coefficients};
 use super::rate_prior::RatePrior;
-use super::{Interpolation, exp_coefficients};
+use super::start_prior::StartPrior;
 use crate::ndt_map::NdtMap;
 use crate::params::NdtParams;
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, SMatrix, SVector, Vector3, Vector6};

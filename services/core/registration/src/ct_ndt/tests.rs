@@ -1,8 +1,12 @@
 use super::*;
+use crate::error::RegistrationError;
 use crate::ndt::register_ndt;
+use crate::params::NdtParams;
 use crate::test_support::{map, perturb, rng, target, true_t_sensor_target};
+use nalgebra::Vector3;
 use nalgebra::Vector6;
 use rand::RngExt;
+use spacepose_geometry::{Point, Pose, so3};
 
 fn random_pose(rng: &mut rand_chacha::ChaCha8Rng, angle_scale: f64) -> Pose {
     let mut v = || {
@@ -155,7 +159,7 @@ fn exp_coefficients_series_meet_the_closed_form() {
         )
     };
     for theta2 in [1e-6, 1e-3, 0.01, 0.039_999, 0.04, 0.1] {
-        let (a, b, c) = super::exp_coefficients(theta2);
+        let (a, b, c) = super::interpolation::exp_coefficients(theta2);
         let (a0, b0, c0) = closed(theta2);
         // The closed forms of b and c lose digits to cancellation at small θ.
         let tol = if theta2 < 1e-3 { 1e-6 } else { 1e-12 };
@@ -163,5 +167,8 @@ fn exp_coefficients_series_meet_the_closed_form() {
         assert!((b - b0).abs() < tol, "b at {theta2}");
         assert!((c - c0).abs() < tol, "c at {theta2}: {c} vs {c0}");
     }
-    assert_eq!(super::exp_coefficients(0.0), (1.0, 0.5, 1.0 / 6.0));
+    assert_eq!(
+        super::interpolation::exp_coefficients(0.0),
+        (1.0, 0.5, 1.0 / 6.0)
+    );
 }

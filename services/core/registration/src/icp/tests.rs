@@ -1,6 +1,12 @@
+use super::nearest_memo::{MemoCounts, NearestMemo};
+use super::register::register_icp_counted;
 use super::*;
+use crate::error::RegistrationError;
+use crate::params::{CellLookup, IcpParams};
 use crate::test_support::{frame, perturb, rng, target, true_t_sensor_target};
+use nalgebra::Vector3;
 use rand::RngExt;
+use spacepose_geometry::{Point, Pose};
 use std::sync::OnceLock;
 
 fn model() -> &'static IcpModel {

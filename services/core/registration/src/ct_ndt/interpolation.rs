@@ -1,28 +1,9 @@
-//! Continuous-time smoothed NDT, seed 000 §3.3: the end pose `T^e` of a scan
-//! is optimised with the start pose `T^s` fixed, each point being mapped by
-//! the pose interpolated at its timestamp (Eq. 13-14), with the Jacobian of
-//! Eq. (15) (Appendix A.2).
+//! Pose interpolation within a scan (seed 000 Eq. 13) and its Jacobian
+//! (Eq. 15, Appendix A.2), shared by the fixed- and free-start CT-NDT.
 
-use crate::degeneracy::constrained_directions;
 use crate::error::RegistrationError;
-use crate::gauss_newton;
-use crate::ndt_map::NdtMap;
-use crate::normal_equations::NormalEquations;
-use crate::params::NdtParams;
-use crate::result::Registration;
-use crate::source::{check_pose, position_is_finite};
 use nalgebra::{Matrix3, Matrix3x6, Vector3};
-use spacepose_geometry::{Point, Pose, so3};
-
-mod displacement_prior;
-mod free_start;
-mod joint;
-mod rate_prior;
-pub use displacement_prior::DisplacementPrior;
-pub use free_start::{
-    CtPriors, CtRegistration, StartPrior, register_ct_ndt_free_start, register_ct_ndt_with_priors,
-};
-pub use rate_prior::RatePrior;
+use spacepose_geometry::{Pose, so3};
 
 /// Start and end times of a scan on the sensor clock (s).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -85,7 +66,7 @@ pub fn interpolate(start: &Pose, end: &Pose, u: f64) -> Pose {
 /// remainder is below 3e-15; above, with one `sin_cos` (it took 8 % of the
 /// free-start CT-NDT's time).
 #[inline]
-fn exp_coefficients(theta2: f64) -> (f64, f64, f64) {
+pub(super) fn exp_coefficients(theta2: f64) -> (f64, f64, f64) {
     if theta2 < TAYLOR_THETA2 {
         let t = -theta2;
         // Σ t^k / (2k + 1)!, Σ t^k / (2k + 2)!, Σ t^k / (2k + 3)!, k ≤ 4.
@@ -108,13 +89,13 @@ fn exp_coefficients(theta2: f64) -> (f64, f64, f64) {
 const TAYLOR_THETA2: f64 = 0.04;
 
 /// What every point shares within one linearisation at `T^e`.
-struct Interpolation {
+pub(super) struct Interpolation {
     /// `R^s c^s = -p^s` and `R^s c^e`: the centre of mass at both ends,
     /// rotated by `R^s` (points are stored as `w = R^s z`).
     q_start: Vector3<f64>,
     q_end: Vector3<f64>,
     /// `φ = Log Q`, `Q = R^e (R^s)⁻¹`.
-    phi: Vector3<f64>,
+    pub(super) phi: Vector3<f64>,
     /// `φ^×` and `(φ^×)²`, for `R^u (R^e)ᵀ = Exp((u-1)φ)`.
     k1: Matrix3<f64>,
     k2: Matrix3<f64>,
@@ -136,19 +117,19 @@ struct Interpolation {
 }
 
 /// Per point: the transformed point and the two Jacobian blocks.
-struct Linearised {
-    point: Vector3<f64>,
-    j_r: Matrix3<f64>,
-    j_t: Matrix3<f64>,
+pub(super) struct Linearised {
+    pub(super) point: Vector3<f64>,
+    pub(super) j_r: Matrix3<f64>,
+    pub(super) j_t: Matrix3<f64>,
     /// The part of `j_r` from the rotation's interpolation (Eq. 15's
     /// rotation block), which the start pose's Jacobian reuses.
-    rot_block: Matrix3<f64>,
+    pub(super) rot_block: Matrix3<f64>,
     /// `Exp((u-1)φ) = R^u (R^e)ᵀ` (`j_t = u` times it).
-    exp_v: Matrix3<f64>,
+    pub(super) exp_v: Matrix3<f64>,
 }
 
 impl Interpolation {
-    fn new(start: &Pose, end: &Pose) -> Self {
+    pub(super) fn new(start: &Pose, end: &Pose) -> Self {
         let phi = so3::log(&(end.rotation * start.rotation.inverse()));
         let k1 = so3::hat(&phi);
         let k2 = k1 * k1;
@@ -178,7 +159,7 @@ impl Interpolation {
     /// given `w = R^s z`, with `R^u y = Exp(uφ) R^s y` by Rodrigues on the
     /// vector.
     #[inline]
-    fn apply(&self, w: &Vector3<f64>, u: f64) -> Linearised {
+    pub(super) fn apply(&self, w: &Vector3<f64>, u: f64) -> Linearised {
         let phi2 = self.phi.norm_squared();
         let v = u - 1.0;
         self.apply_with(
@@ -194,7 +175,7 @@ impl Interpolation {
     /// free-start CT-NDT shares them between both ends, whose factors are
     /// `u` and `1 - u`).
     #[inline]
-    fn apply_with(
+    pub(super) fn apply_with(
         &self,
         w: &Vector3<f64>,
         u: f64,
@@ -232,7 +213,7 @@ impl Interpolation {
     /// (15)'s rotation block of the end. Cheaper than Eq. (15) with the
     /// ends swapped, which it equals.
     #[cfg(test)]
-    fn start_jacobian(
+    pub(super) fn start_jacobian(
         &self,
         end: &Linearised,
         u: f64,
@@ -249,7 +230,7 @@ impl Interpolation {
     /// The rotation block `J^s_r` of [`Interpolation::start_jacobian`]
     /// (the free-start CT-NDT forms the translation block from `exp_v`).
     #[inline]
-    fn start_rotation_jacobian(
+    pub(super) fn start_rotation_jacobian(
         &self,
         end: &Linearised,
         u: f64,
@@ -286,83 +267,3 @@ pub fn ct_point_jacobian(start: &Pose, end: &Pose, u: f64, z: &Vector3<f64>) -> 
     j.fixed_view_mut::<3, 3>(0, 3).copy_from(&l.j_t);
     j
 }
-
-/// Normal equations of Eq. (14) at end pose `end`, every `stride`-th point.
-fn linearise(
-    map: &NdtMap,
-    points: &[(Vector3<f64>, f64)],
-    start: &Pose,
-    end: &Pose,
-    stride: usize,
-    params: &NdtParams,
-) -> NormalEquations {
-    let interp = Interpolation::new(start, end);
-    let mut ne = NormalEquations::new();
-    // `points` holds `(R^s z, u)`.
-    for (w, u) in points.iter().step_by(stride.max(1)) {
-        let l = interp.apply(w, *u);
-        if let Some((k, _)) = map.nearest_cell(&l.point, params.max_distance_m, params.lookup) {
-            let (mean, information) = map.mean_and_information(k);
-            ne.add_general(&l.j_r, &l.j_t, information, &(l.point - mean));
-        }
-    }
-    ne
-}
-
-/// Continuous-time NDT: registers a scan whose points carry timestamps
-/// within `scan`, optimising the end pose `T^e = t_target_sensor` at
-/// `scan.end_s` with the start pose `t_target_sensor_start` (at
-/// `scan.start_s`, typically the previous result) fixed (Eq. 14).
-///
-/// Same loop, termination and result as [`crate::register_ndt`]; the
-/// returned pose and information refer to `T^e`. Points whose position or
-/// timestamp is not finite are skipped and counted. Timestamps outside the
-/// interval extrapolate the constant-velocity motion.
-///
-/// Errors: those of [`crate::register_ndt`], plus an invalid `scan` or a
-/// non-finite start pose.
-pub fn register_ct_ndt(
-    map: &NdtMap,
-    source: &[Point],
-    scan: &ScanTimes,
-    t_target_sensor_start: &Pose,
-    initial_t_target_sensor_end: &Pose,
-    params: &NdtParams,
-) -> Result<Registration, RegistrationError> {
-    params.validate()?;
-    scan.validate()?;
-    check_pose("t_target_sensor_start", t_target_sensor_start)?;
-    check_pose("initial_t_target_sensor_end", initial_t_target_sensor_end)?;
-    if source.is_empty() {
-        return Err(RegistrationError::EmptyCloud);
-    }
-    let points: Vec<(Vector3<f64>, f64)> = source
-        .iter()
-        .filter(|p| position_is_finite(p) && p.t.is_finite())
-        // Precomputed `w = R^s z`, fixed through the iterations.
-        .map(|p| {
-            (
-                t_target_sensor_start.rotation * p.position(),
-                scan.factor(p.t),
-            )
-        })
-        .collect();
-    if points.is_empty() {
-        return Err(RegistrationError::AllPointsNonFinite {
-            count: source.len(),
-        });
-    }
-    let skipped = source.len() - points.len();
-    let constrained = constrained_directions(map, source, initial_t_target_sensor_end, params);
-    gauss_newton::run(
-        *initial_t_target_sensor_end,
-        params,
-        points.len(),
-        skipped,
-        constrained.as_ref(),
-        |end, stride| linearise(map, &points, t_target_sensor_start, end, stride, params),
-    )
-}
-
-#[cfg(test)]
-mod tests;
