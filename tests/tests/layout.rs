@@ -39,21 +39,32 @@ fn lib_and_bin_targets(meta: &Metadata) -> Vec<(String, String, PathBuf)> {
 
 fn relative(path: &Path) -> String {
     let root = repo_root();
-    path.strip_prefix(&root).unwrap_or(path).display().to_string()
+    path.strip_prefix(&root)
+        .unwrap_or(path)
+        .display()
+        .to_string()
 }
 
 #[test]
 fn algorithm_libraries_reach_no_bus_crate() {
     let meta = metadata();
     let core = meta.members_under(&repo_root().join("services").join("core"));
-    assert!(core.len() >= 10, "only {} crates under services/core", core.len());
+    assert!(
+        core.len() >= 10,
+        "only {} crates under services/core",
+        core.len()
+    );
     let mut reached = Vec::new();
     for id in core {
         for path in forbidden_paths(&meta, id, false, is_bus_crate) {
             reached.push(path.join(" -> "));
         }
     }
-    assert!(reached.is_empty(), "bus crates reached:\n{}", reached.join("\n"));
+    assert!(
+        reached.is_empty(),
+        "bus crates reached:\n{}",
+        reached.join("\n")
+    );
 }
 
 #[test]

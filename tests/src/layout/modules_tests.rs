@@ -26,7 +26,10 @@ fn names(c: &CrateModules) -> Vec<Vec<String>> {
 fn a_circle_through_a_re_export_and_a_macro_argument_is_found() {
     let (_dir, c) = fixture(&[
         ("lib.rs", "mod a;\nmod b;\npub use a::Alpha;\n"),
-        ("a.rs", "pub struct Alpha;\npub fn show() { println!(\"{}\", crate::b::beta()); }\n"),
+        (
+            "a.rs",
+            "pub struct Alpha;\npub fn show() { println!(\"{}\", crate::b::beta()); }\n",
+        ),
         ("b.rs", "pub fn beta() -> u8 { let _ = crate::Alpha; 1 }\n"),
     ]);
     assert_eq!(names(&c), vec![vec!["a.rs", "b.rs"]]);

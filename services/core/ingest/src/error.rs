@@ -1,6 +1,5 @@
 //! The error type of the ingest library.
 
-
 /// Everything that can go wrong while ingesting a frame or building the
 /// ingest stage. A rejected frame is one of these values, never a panic.
 ///

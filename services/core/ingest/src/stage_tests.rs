@@ -118,7 +118,13 @@ fn the_crop_keeps_every_point_inside_in_time_order() {
     for k in 0..500 {
         let x = 0.02 * k as f32 + 0.005;
         pts.push(Point::new(x, 0.005, 10.005, 1.0, 0.002 * k as f64));
-        pts.push(Point::new(x + 0.001, 0.005, 10.005, 3.0, 0.002 * k as f64 + 0.001));
+        pts.push(Point::new(
+            x + 0.001,
+            0.005,
+            10.005,
+            3.0,
+            0.002 * k as f64 + 0.001,
+        ));
     }
     let mut s = stage();
     let (out, report) = s.process(&pts, 0.0, 1.0, None).unwrap();

@@ -4,9 +4,9 @@
 
 use crate::config::SensorConfig;
 use crate::detection::DetectionModel;
+use crate::frame::{INTENSITY_REFERENCE_M2, ReturnKind};
 use crate::optics::tilt;
 use crate::scene::BeamEcho;
-use crate::frame::{INTENSITY_REFERENCE_M2, ReturnKind};
 use nalgebra::Vector3;
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;

@@ -63,14 +63,15 @@ pub fn update(root: &Path, write: bool) -> Result<Vec<String>> {
             _ => comparison(&before, &blind),
         };
         let path = root.join(file);
-        let text =
-            std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("reading {}", path.display()))?;
         let new = replace_block(&text, name, &body)
             .with_context(|| format!("{}: no marker <!-- results:{name} -->", path.display()))?;
         if new != text {
             stale.push(file.to_string());
             if write {
-                std::fs::write(&path, new).with_context(|| format!("writing {}", path.display()))?;
+                std::fs::write(&path, new)
+                    .with_context(|| format!("writing {}", path.display()))?;
             }
         }
     }

@@ -89,7 +89,9 @@ pub fn pool(runs: &[Run]) -> Pools {
     let mut frames: BTreeMap<(String, String), (usize, Vec<FrameErr>)> = BTreeMap::new();
     for run in runs {
         for (mode, m) in &run.modes {
-            let entry = frames.entry((run.scenario.clone(), mode.clone())).or_default();
+            let entry = frames
+                .entry((run.scenario.clone(), mode.clone()))
+                .or_default();
             entry.0 += 1;
             let after = m.series.iter().filter(|f| f.frame >= run.warmup).cloned();
             entry.1.extend(after);
@@ -107,8 +109,16 @@ pub fn pool(runs: &[Run]) -> Pools {
 
 fn pooled(seeds: usize, series: &[FrameErr]) -> Pooled {
     let published = |f: &&FrameErr| f.status != "lost";
-    let ang: Vec<f64> = series.iter().filter(published).filter_map(|f| f.ang_err_deg).collect();
-    let pos: Vec<f64> = series.iter().filter(published).filter_map(|f| f.pos_err_cm).collect();
+    let ang: Vec<f64> = series
+        .iter()
+        .filter(published)
+        .filter_map(|f| f.ang_err_deg)
+        .collect();
+    let pos: Vec<f64> = series
+        .iter()
+        .filter(published)
+        .filter_map(|f| f.pos_err_cm)
+        .collect();
     let is_diverged = |f: &FrameErr| {
         f.status == "lost"
             || !(f.ang_err_deg.is_some_and(|a| a <= DIVERGED_DEG)
