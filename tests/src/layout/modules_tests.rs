@@ -53,3 +53,19 @@ fn visibility_tests_and_facades_are_not_imports() {
     assert!(names(&c).is_empty(), "{:?}", names(&c));
     assert_eq!(c.production_files().count(), 3);
 }
+
+#[test]
+fn a_path_through_an_imported_module_name_is_an_import() {
+    let (_dir, c) = fixture(&[
+        ("lib.rs", "mod a;\nmod b;\n"),
+        (
+            "a.rs",
+            "use crate::b;\npub struct Alpha;\npub fn f() -> u8 { b::inner::beta() }\n",
+        ),
+        (
+            "b.rs",
+            "pub mod inner { pub fn beta() -> u8 { let _ = crate::a::Alpha; 1 } }\n",
+        ),
+    ]);
+    assert_eq!(names(&c), vec![vec!["a.rs", "b.rs"]]);
+}

@@ -54,8 +54,7 @@ impl Default for FilterConfig {
             initial_sigma_pos_m: 0.05,
             initial_sigma_v_mps: 0.5,
             initial_sigma_w_degps: 30.0,
-            // Off: registration covariances are over-confident (README,
-            // "Filter gate"), and a partial `[filter]` section takes its
+            // Off: registration covariances are over-confident (docs/design/filter-tuning.md), and a partial `[filter]` section takes its
             // missing keys from here, so the default must be what the
             // services run with (a Some here used to turn the gate on in
             // every config file that did not name it).

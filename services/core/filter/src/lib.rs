@@ -9,11 +9,11 @@
 //!   information matrix and a Mahalanobis innovation gate.
 //! - [`motion_compensation`]: un-blurring of a scan with the predicted motion
 //!   (Eq. 12).
-//! - [`wire`]: conversions to and from the suite's messages (`FilterState`,
-//!   `PoseEstimate`, `AcquisitionResult`); [`selector`]: one estimate per
-//!   frame (primary/standby with a per-frame deadline), with sticky
-//!   [`failover`] (promotion of the standby, revert); [`service`]: the logic of the `spacepose-filter` binary, bus-free;
-//!   [`snapshot`]: the state persisted for a restarted filter service.
+//! - [`config`], [`kalman`] (the shared Kalman step), [`error`].
+//!
+//! The filter service (`services/nodes/filter`: one estimate per frame,
+//! failover, snapshots, wire conversions) is built on this library; the
+//! library itself knows nothing of the bus.
 //!
 //! Units SI. `R = r_sensor_target` (target body → sensor), `p = p_sensor` the
 //! target origin in the sensor frame, `v_sensor = dp/dt` in the sensor frame,

@@ -7,7 +7,7 @@ use nalgebra::{Rotation3, Vector3};
 use crate::error::TargetError;
 use crate::material::Material;
 use crate::mesh::{Mesh, RayHit};
-use crate::{builtin, loaders, sampling};
+use crate::{loaders, sampling};
 
 /// A target model. The mesh is expressed in the target body frame, whose origin is the
 /// centre of mass (each built-in target documents its axes; loaded meshes use the
@@ -95,16 +95,6 @@ impl Target {
         Ok(self)
     }
 
-    /// A built-in target by name (see [`Target::BUILTIN`]): `"envisat"` (seed 002 §3.1) or
-    /// `"deos"` (seed 004 §III.C.4).
-    pub fn builtin(name: &str) -> Result<Target, TargetError> {
-        match name {
-            "envisat" => builtin::envisat::target(),
-            "deos" => builtin::deos::target(),
-            other => Err(TargetError::UnknownBuiltin(other.to_owned())),
-        }
-    }
-
     /// Loads an STL, OBJ or PLY mesh (chosen by the case-insensitive extension).
     ///
     /// Coordinates are read in the file's own units and multiplied by `scale`; the result is
@@ -123,20 +113,9 @@ impl Target {
         )
     }
 
-    /// A built-in target if `spec` is one of [`Target::BUILTIN`], otherwise a mesh file path
-    /// (see [`Target::load`]). `scale` multiplies the coordinates in both cases (use 1.0 for
-    /// built-in targets at their true size).
-    pub fn resolve(spec: &str, scale: f64) -> Result<Target, TargetError> {
-        if Target::BUILTIN.contains(&spec) {
-            Target::builtin(spec)?.scaled(spec, scale)
-        } else {
-            Target::load(Path::new(spec), scale)
-        }
-    }
-
     /// This target with all coordinates multiplied by `scale` (origin, materials and
     /// symmetries unchanged). `spec` only names the target in the error message.
-    fn scaled(self, spec: &str, scale: f64) -> Result<Target, TargetError> {
+    pub(crate) fn scaled(self, spec: &str, scale: f64) -> Result<Target, TargetError> {
         if !(scale.is_finite() && scale > 0.0) {
             return Err(TargetError::InvalidScale {
                 spec: spec.to_owned(),

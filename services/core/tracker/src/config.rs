@@ -85,8 +85,8 @@ pub struct TrackerConfig {
     /// fused as `deblur` fuses it) instead of by CT-NDT's two poses (not in
     /// the paper; 0 = always CT-NDT). Why: CT-NDT fits 12 degrees of freedom
     /// to the same points, and on a sparse frame the end pose, extrapolated
-    /// from the scan's last points, wanders the most (see the README,
-    /// "ct-ndt on sparse frames"). Tuned on seed 1 over 0, 3000, 4000 and
+    /// from the scan's last points, wanders the most (see
+    /// `docs/design/ct-ndt-motion-prior.md`). Tuned on seed 1 over 0, 3000, 4000 and
     /// 5000: slow-spin max 3.22, 2.03, 2.01, 2.95° (mean over its frames
     /// below 3000 points 0.85, 0.58, 0.55, 0.61°); tumbling max 2.27, 2.01,
     /// 1.81, 1.89° (0.94, 0.68, 0.68, 0.67°). 4000, the lowest max on both.
@@ -100,8 +100,8 @@ pub struct TrackerConfig {
     /// (`(Δt² Σ_ω)⁻¹`, `(Δt² Σ_v)⁻¹`, in the start prior's units) times
     /// this. 0 = none (the start prior of the free-start CT-NDT); large = the
     /// predicted motion, i.e. `deblur`. Not in the paper; see
-    /// `spacepose_registration::{RatePrior, DisplacementPrior}` and the
-    /// README, "ct-ndt's motion prior".
+    /// `spacepose_registration::{RatePrior, DisplacementPrior}` and
+    /// `docs/design/ct-ndt-motion-prior.md`.
     pub ct_ndt_motion_prior_weight: f64,
     /// In `ct-ndt` mode, a frame whose CT-NDT stalls (stops at its
     /// iteration limit still moving by more than

@@ -26,6 +26,10 @@ pub struct Module {
     /// `pub use` bindings: name → path (as written).
     reexports: BTreeMap<String, Vec<String>>,
     globs: Vec<Vec<String>>,
+    /// Private `use` bindings: name → path (as written), so a path that
+    /// starts with an imported module name (`builtin::deos::target()` after
+    /// `use crate::builtin;`) resolves through it.
+    bindings: BTreeMap<String, Vec<String>>,
     /// Paths named by the module's own (non-test) code.
     pub uses: Vec<Vec<String>>,
 }
@@ -94,7 +98,10 @@ impl Walker {
                                 m.reexports.insert(name, target.clone());
                             }
                             None if public => m.globs.push(target.clone()),
-                            _ => {}
+                            Some(name) => {
+                                m.bindings.insert(name, target.clone());
+                            }
+                            None => {}
                         }
                         if !(test || (public && facade)) {
                             m.uses.push(target);
@@ -179,6 +186,15 @@ impl Walker {
                     .modules
                     .get(at)
                     .is_some_and(|m| m.children.contains(first)) => {}
+            Some(first) => {
+                let bound = self.modules.get(at)?.bindings.get(first)?;
+                if bound.len() < 2 {
+                    return None;
+                }
+                let mut p = bound.clone();
+                p.extend(used[1..].iter().cloned());
+                return self.resolve(at, &p, depth + 1);
+            }
             _ => return None,
         }
         self.walk(cur, rest, depth)

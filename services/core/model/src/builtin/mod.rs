@@ -6,6 +6,36 @@
 pub mod deos;
 pub mod envisat;
 
+use crate::error::TargetError;
+use crate::target::Target;
+use std::path::Path;
+
+/// Built-in targets by name. (These constructors live here, beside the
+/// targets they build, so the target module does not reach back into the
+/// built-in ones.)
+impl Target {
+    /// A built-in target by name (see [`Target::BUILTIN`]): `"envisat"` (seed 002 §3.1) or
+    /// `"deos"` (seed 004 §III.C.4).
+    pub fn builtin(name: &str) -> Result<Target, TargetError> {
+        match name {
+            "envisat" => envisat::target(),
+            "deos" => deos::target(),
+            other => Err(TargetError::UnknownBuiltin(other.to_owned())),
+        }
+    }
+
+    /// A built-in target if `spec` is one of [`Target::BUILTIN`], otherwise a mesh file path
+    /// (see [`Target::load`]). `scale` multiplies the coordinates in both cases (use 1.0 for
+    /// built-in targets at their true size).
+    pub fn resolve(spec: &str, scale: f64) -> Result<Target, TargetError> {
+        if Target::BUILTIN.contains(&spec) {
+            Target::builtin(spec)?.scaled(spec, scale)
+        } else {
+            Target::load(Path::new(spec), scale)
+        }
+    }
+}
+
 #[cfg(test)]
 pub(crate) mod symmetry_check {
     use nalgebra::Rotation3;

@@ -1,5 +1,5 @@
 //! Continuous-time NDT with a free start pose (a departure from seed 000
-//! §3.3, measured in the tracker's README section).
+//! §3.3, measured in `docs/design/ct-ndt-start-pose.md`).
 //!
 //! Eq. (14) fixes the start pose `T^s` at the previous result, so an error
 //! there moves the early points of the scan for good: they fall outside the

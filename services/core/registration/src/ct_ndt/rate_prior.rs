@@ -1,5 +1,5 @@
 //! A Gaussian prior on the rotation a continuous-time scan turns through
-//! (not in seed 000; measured in the tracker's README section).
+//! (not in seed 000; measured in `docs/design/ct-ndt-motion-prior.md`).
 //!
 //! The free-start CT-NDT ([`super::register_ct_ndt_free_start`]) fits the
 //! start and end poses of a scan, i.e. a pose and a motion. A 1 Hz scan at
