@@ -30,7 +30,7 @@ pub use args::ServiceArgs;
 pub use config::{ServiceConfig, load_config};
 pub use health::HealthReporter;
 pub use link::{Access, LinkSpec, LinkStatus};
-pub use local::{Envelope, LocalBus};
+pub use local::{Collect, Envelope, LocalBus};
 pub use node::{Ctx, Flow, Node, NodeInfo, Outbox};
 pub use run::main;
 pub use runtime::{init_logging, shutdown_flag};

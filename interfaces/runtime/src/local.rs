@@ -47,9 +47,10 @@ impl Envelope {
     }
 }
 
-/// Collects a node's outputs.
-#[derive(Default)]
-struct Collect(Vec<Envelope>);
+/// Collects a node's outputs, in order (what `LocalBus` routes; node unit
+/// tests drive a node over one with `Ctx::new`).
+#[derive(Debug, Default)]
+pub struct Collect(pub Vec<Envelope>);
 
 impl Outbox for Collect {
     fn message(&mut self, msg: &Message) -> anyhow::Result<()> {

@@ -6,36 +6,12 @@ use super::*;
 use spacepose_geometry::Point;
 use spacepose_ingest_node::IngestNode;
 use spacepose_messages::{CloudHeader, Counters, Names, TruthMsg};
-use spacepose_runtime::{Envelope, LocalBus, Outbox};
+use spacepose_runtime::{Collect, Envelope, LocalBus};
 use std::time::Duration;
 
 const S: i64 = 1_000_000_000;
 /// An arbitrary wall-clock origin.
 const T0: i64 = 1_700_000_000 * S;
-
-/// Collects what the node sends.
-#[derive(Default)]
-struct Sent(Vec<Envelope>);
-
-impl Outbox for Sent {
-    fn message(&mut self, msg: &Message) -> anyhow::Result<()> {
-        self.0.push(Envelope::Message(*msg));
-        Ok(())
-    }
-
-    fn cloud(&mut self, topic: Topic, header: CloudHeader, points: &[Point]) -> anyhow::Result<()> {
-        self.0.push(Envelope::Cloud {
-            topic,
-            header,
-            points: points.to_vec(),
-        });
-        Ok(())
-    }
-
-    fn json(&mut self, _: &str, _: &str) -> anyhow::Result<()> {
-        anyhow::bail!("no ground link")
-    }
-}
 
 /// A small, fast run: 0.05 s frames without clutter.
 fn config(frames: u64, rate_hz: f64) -> LidarSimConfig {
@@ -64,7 +40,7 @@ fn node(config: LidarSimConfig) -> LidarSimNode {
 
 /// One poll at `now_ns`: the flow and what was sent.
 fn poll(node: &mut LidarSimNode, counters: &mut Counters, now_ns: i64) -> (Flow, Vec<Envelope>) {
-    let mut out = Sent::default();
+    let mut out = Collect::default();
     let flow = node.poll(&mut Ctx::new(&mut out, counters, now_ns));
     (flow, out.0)
 }
