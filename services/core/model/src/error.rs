@@ -58,4 +58,13 @@ pub enum TargetError {
         /// Why it was rejected.
         message: String,
     },
+    /// A target package (directory or embedded manifest) is malformed: bad
+    /// manifest, unknown format, mesh file not in the package subset, or an
+    /// invalid calibration.
+    #[error("invalid target package: {0}")]
+    InvalidPackage(String),
+    /// Symmetry detection options out of range (see
+    /// [`crate::symmetry::SymmetryOptions::validate`]).
+    #[error("invalid symmetry options: {0}")]
+    InvalidSymmetryOptions(String),
 }

@@ -13,14 +13,17 @@ mod error;
 mod loaders;
 pub mod material;
 mod mesh;
+pub mod package;
 pub mod sampling;
 mod shapes;
+pub mod symmetry;
 mod target;
 
 pub use consistency::{RangeMargin, RayConsistency, ray_consistency};
 pub use error::TargetError;
 pub use material::{Material, MaterialClass, MaterialId};
 pub use mesh::{Mesh, RayHit};
+pub use symmetry::{SymmetryOptions, SymmetryReport, detect_symmetries};
 pub use target::Target;
 
 #[cfg(test)]

@@ -30,6 +30,15 @@ type RawMesh = (Vec<Vector3<f64>>, Vec<[u32; 3]>);
 /// area-weighted centroid. Returns the mesh with its name (the file stem); `Target::load`
 /// wraps it in a target.
 pub(crate) fn load_mesh(path: &Path, scale: f64) -> Result<(String, Mesh), TargetError> {
+    load_mesh_with_origin(path, scale).map(|(name, mesh, _)| (name, mesh))
+}
+
+/// [`load_mesh`], also returning where the body origin (the centroid) lies
+/// in the scaled file frame (m).
+pub(crate) fn load_mesh_with_origin(
+    path: &Path,
+    scale: f64,
+) -> Result<(String, Mesh, Vector3<f64>), TargetError> {
     if !(scale.is_finite() && scale > 0.0) {
         return Err(TargetError::InvalidScale {
             spec: path.display().to_string(),
@@ -67,7 +76,7 @@ pub(crate) fn load_mesh(path: &Path, scale: f64) -> Result<(String, Mesh), Targe
     let name = path
         .file_stem()
         .map_or_else(|| "mesh".to_owned(), |s| s.to_string_lossy().into_owned());
-    Ok((name, mesh))
+    Ok((name, mesh, centroid))
 }
 
 fn read_error(path: &Path, message: impl std::fmt::Display) -> TargetError {

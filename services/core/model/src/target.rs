@@ -113,6 +113,33 @@ impl Target {
         )
     }
 
+    /// This target renamed, with another symmetry group and twins (checked
+    /// as in [`Target::new`]): what a package records.
+    pub fn with_symmetries(
+        self,
+        name: &str,
+        symmetries: Vec<Rotation3<f64>>,
+        twins: Vec<Rotation3<f64>>,
+    ) -> Result<Target, TargetError> {
+        Target::new(name, self.mesh, self.materials, symmetries)?.with_twins(twins)
+    }
+
+    /// [`Target::load`], also returning where the body origin (the
+    /// area-weighted centroid) lies in the file's frame, scaled (m).
+    pub fn load_with_origin(
+        path: &Path,
+        scale: f64,
+    ) -> Result<(Target, Vector3<f64>), TargetError> {
+        let (name, mesh, origin) = loaders::load_mesh_with_origin(path, scale)?;
+        let target = Target::new(
+            &name,
+            mesh,
+            vec![Material::default_structure()],
+            vec![Rotation3::identity()],
+        )?;
+        Ok((target, origin))
+    }
+
     /// This target with all coordinates multiplied by `scale` (origin, materials and
     /// symmetries unchanged). `spec` only names the target in the error message.
     pub(crate) fn scaled(self, spec: &str, scale: f64) -> Result<Target, TargetError> {
