@@ -24,7 +24,7 @@ pub(crate) fn stalled(l: &LossConfig, r: &Registration) -> bool {
 pub(crate) fn quality_issues(c: &TrackerConfig, r: &Registration) -> Vec<String> {
     let l = &c.loss;
     let mut reasons = Vec::new();
-    if r.inliers < l.min_inliers || r.inlier_fraction() < l.min_inlier_fraction {
+    if r.inliers < l.min_inliers || r.inlier_fraction() < l.inlier_fraction_bound() {
         reasons.push(format!(
             "{} inliers ({:.0}%)",
             r.inliers,
@@ -34,7 +34,7 @@ pub(crate) fn quality_issues(c: &TrackerConfig, r: &Registration) -> Vec<String>
     let max_cost = if c.mode == TrackingMode::Icp {
         l.max_mean_cost_icp_m2
     } else {
-        l.max_mean_cost_ndt
+        l.mean_cost_bound_ndt()
     };
     if r.cost.mean.is_nan() || r.cost.mean > max_cost {
         reasons.push(format!(

@@ -38,7 +38,7 @@ pub use config::{CtStart, LossConfig, TrackerConfig};
 pub use error::TrackError;
 pub use held_rotation::{HeldCorrection, HeldRotation, HeldRotationConfig};
 pub use mode::TrackingMode;
-pub use model::TrackingModel;
+pub use model::{TargetThresholds, TrackingModel};
 pub use output::{Timings, TrackOutput};
 pub use pipeline::{FramePipeline, Prepared};
 pub use status::TrackStatus;

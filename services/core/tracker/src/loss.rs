@@ -6,13 +6,12 @@ use serde::{Deserialize, Serialize};
 
 /// When a frame counts as degraded, and when the track counts as lost.
 ///
-/// The thresholds were set from simulated `deos` frames of the slow-spin
-/// scenario with seed 1 only (never an evaluation seed): well-aligned frames
-/// have inlier fractions above 0.55 and a mean NDT cost per inlier of 4.5 at
-/// the median and up to about 7 (it saturates, since associations stop at
-/// the maximum distance, so it is a weak signal); failed registrations show
-/// a collapsed inlier fraction, a cost above 10, or a jump away from the
-/// prediction; a 60° symmetric flip of the hexagonal body (seed 000 §5.2)
+/// The shape-dependent bounds (mean NDT cost, inlier fraction) come from
+/// the target package, calibrated from simulated frames of that target
+/// (`docs/design/target-packages.md`); the others were set from simulated
+/// `deos` frames of the slow-spin scenario with seed 1 only: failed
+/// registrations show a collapsed inlier fraction, a high cost, or a jump
+/// away from the prediction; a 60° symmetric flip of the hexagonal body (seed 000 §5.2)
 /// is far above the innovation limits.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -29,9 +28,14 @@ pub struct LossConfig {
     /// Fewest inliers for a usable registration.
     pub min_inliers: usize,
     /// Smallest fraction of the filtered points that must find a cell.
-    pub min_inlier_fraction: f64,
-    /// Largest mean cost per inlier (NDT: Mahalanobis, unitless; ICP: m²).
-    pub max_mean_cost_ndt: f64,
+    /// Unset (the default): the target package's calibrated value
+    /// ([`crate::TrackingModel::thresholds`]).
+    pub min_inlier_fraction: Option<f64>,
+    /// Largest mean NDT cost per inlier (Mahalanobis, unitless). Unset (the
+    /// default): the target package's calibrated value, since the cost of a
+    /// good fit depends on the target's shape (curved surfaces fit the
+    /// planar NDT cells worse).
+    pub max_mean_cost_ndt: Option<f64>,
     /// Largest mean squared distance for ICP (m²).
     pub max_mean_cost_icp_m2: f64,
     /// Largest attitude jump from the filter prediction (deg).
@@ -54,8 +58,8 @@ impl Default for LossConfig {
         Self {
             min_points: 20,
             min_inliers: 100,
-            min_inlier_fraction: 0.3,
-            max_mean_cost_ndt: 10.0,
+            min_inlier_fraction: None,
+            max_mean_cost_ndt: None,
             max_mean_cost_icp_m2: 0.002,
             max_innovation_rot_deg: 15.0,
             max_innovation_pos_m: 0.3,
@@ -67,13 +71,39 @@ impl Default for LossConfig {
 }
 
 impl LossConfig {
+    /// This configuration with its unset target-dependent keys taken from
+    /// `thresholds` (what [`crate::Tracker::new`] runs on).
+    pub fn resolved(&self, thresholds: &crate::model::TargetThresholds) -> LossConfig {
+        LossConfig {
+            min_inlier_fraction: self
+                .min_inlier_fraction
+                .or(Some(thresholds.min_inlier_fraction)),
+            max_mean_cost_ndt: self
+                .max_mean_cost_ndt
+                .or(Some(thresholds.max_mean_cost_ndt)),
+            ..self.clone()
+        }
+    }
+
+    /// The mean-cost bound in force: set or resolved, else the uncalibrated
+    /// value (only a configuration never passed through [`Self::resolved`]).
+    pub(crate) fn mean_cost_bound_ndt(&self) -> f64 {
+        self.max_mean_cost_ndt
+            .unwrap_or(crate::model::TargetThresholds::UNCALIBRATED.max_mean_cost_ndt)
+    }
+
+    /// The inlier-fraction bound in force (see [`Self::mean_cost_bound_ndt`]).
+    pub(crate) fn inlier_fraction_bound(&self) -> f64 {
+        self.min_inlier_fraction
+            .unwrap_or(crate::model::TargetThresholds::UNCALIBRATED.min_inlier_fraction)
+    }
+
     /// Checks every value; NaN fails (the `loss.*` part of
     /// [`TrackerConfig::validate`](crate::TrackerConfig::validate)).
     pub(crate) fn validate(&self) -> Result<(), TrackError> {
         let bad = |what: &str, v: f64| TrackError::InvalidConfig(format!("{what} = {v}"));
         let l = self;
         let positive = [
-            ("loss.max_mean_cost_ndt", l.max_mean_cost_ndt),
             ("loss.max_mean_cost_icp_m2", l.max_mean_cost_icp_m2),
             ("loss.max_innovation_rot_deg", l.max_innovation_rot_deg),
             ("loss.max_innovation_pos_m", l.max_innovation_pos_m),
@@ -85,11 +115,15 @@ impl LossConfig {
                 return Err(bad(&format!("{name} must be finite and > 0"), v));
             }
         }
-        if !(l.min_inlier_fraction.is_finite() && (0.0..=1.0).contains(&l.min_inlier_fraction)) {
-            return Err(bad(
-                "loss.min_inlier_fraction must be in [0, 1]",
-                l.min_inlier_fraction,
-            ));
+        if let Some(c) = l.max_mean_cost_ndt
+            && !(c.is_finite() && c > 0.0)
+        {
+            return Err(bad("loss.max_mean_cost_ndt must be finite and > 0", c));
+        }
+        if let Some(f) = l.min_inlier_fraction
+            && !(f.is_finite() && (0.0..=1.0).contains(&f))
+        {
+            return Err(bad("loss.min_inlier_fraction must be in [0, 1]", f));
         }
         if l.min_points == 0 {
             return Err(TrackError::InvalidConfig(

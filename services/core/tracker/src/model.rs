@@ -24,7 +24,41 @@ struct LazyIcp {
 pub struct TrackingModel {
     /// Smoothed NDT map of the model cloud.
     pub map: Arc<NdtMap>,
+    /// The target's calibrated loss thresholds (from its package); they
+    /// fill the `loss` keys a configuration leaves unset.
+    pub thresholds: TargetThresholds,
     icp: Arc<LazyIcp>,
+}
+
+/// The loss thresholds that depend on the target's shape, calibrated per
+/// target from simulated frames when its package is prepared (crate
+/// `spacepose-prepare`; `docs/design/target-packages.md`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TargetThresholds {
+    /// Largest mean NDT cost per inlier (`loss.max_mean_cost_ndt`).
+    pub max_mean_cost_ndt: f64,
+    /// Smallest inlier fraction (`loss.min_inlier_fraction`).
+    pub min_inlier_fraction: f64,
+}
+
+impl TargetThresholds {
+    /// For a model built from a bare cloud, with no package: the values set
+    /// by hand on `deos` before packages existed (10 and 0.3). A service
+    /// always loads a package, so only tests and library users with their
+    /// own clouds see these.
+    pub const UNCALIBRATED: TargetThresholds = TargetThresholds {
+        max_mean_cost_ndt: 10.0,
+        min_inlier_fraction: 0.3,
+    };
+}
+
+impl From<&spacepose_model::package::Calibration> for TargetThresholds {
+    fn from(c: &spacepose_model::package::Calibration) -> Self {
+        TargetThresholds {
+            max_mean_cost_ndt: c.max_mean_cost_ndt,
+            min_inlier_fraction: c.min_inlier_fraction,
+        }
+    }
 }
 
 impl TrackingModel {
@@ -42,11 +76,18 @@ impl TrackingModel {
     pub fn from_map(map: NdtMap, model_target: &[Vector3<f64>]) -> Self {
         Self {
             map: Arc::new(map),
+            thresholds: TargetThresholds::UNCALIBRATED,
             icp: Arc::new(LazyIcp {
                 model_target: model_target.to_vec(),
                 built: OnceLock::new(),
             }),
         }
+    }
+
+    /// This model with a target's calibrated thresholds.
+    pub fn with_thresholds(mut self, thresholds: TargetThresholds) -> Self {
+        self.thresholds = thresholds;
+        self
     }
 
     /// The ICP model, built now if it was not yet (shared by every clone).

@@ -43,6 +43,8 @@ impl Tracker {
     /// A tracker for `model`, not yet initialised.
     pub fn new(config: TrackerConfig, model: TrackingModel) -> Result<Self, TrackError> {
         config.validate()?;
+        let mut config = config;
+        config.loss = config.loss.resolved(&model.thresholds);
         let filter = RelativeMotionFilter::new(config.filter.clone())?;
         let pipeline = FramePipeline::new(config.voxel_leaf_m)?;
         let held = HeldRotation::new(config.held_rotation.clone());
