@@ -14,10 +14,9 @@
 
 use spacepose_bus::Bus;
 use spacepose_e2e::*;
-use spacepose_eval::tracking::{EvalConfig, crop_for, evaluate};
+use spacepose_eval::tracking::{EvalConfig, evaluate};
 use spacepose_lidar_sim_node::LidarSimConfig;
 use spacepose_messages::{Names, PoseEstimate, WireStatus};
-use spacepose_model::Target;
 use spacepose_scenario::ScenarioKind;
 use spacepose_tracker::TrackingMode;
 use std::collections::BTreeMap;
@@ -43,10 +42,9 @@ fn frame_period_s() -> f64 {
         .frame_period_s()
 }
 
-/// lidar-sim (truth acquisition, as eval), ingest with the target's crop,
+/// lidar-sim (truth acquisition, as eval), ingest on the target's package,
 /// the tracker in deblur mode and the filter; nothing else.
 fn descriptor(dir: &std::path::Path) -> std::path::PathBuf {
-    let target = Target::builtin("deos").expect("deos is built in");
     let text = format!(
         r#"prefix = "frame-path"
 heartbeat_ms = 500
@@ -73,6 +71,8 @@ exit_at_end = false
 [[service]]
 name = "ingest"
 kind = "ingest"
+[service.config]
+target = "deos"
 
 [[service]]
 name = "tracker"
@@ -89,13 +89,6 @@ config = {{}}
 "#,
         period = frame_period_s(),
     );
-    // Ingest's configuration is the crop eval uses, written as a table.
-    let mut doc: toml::Table = toml::from_str(&text).expect("the descriptor parses");
-    let crop = toml::Value::try_from(crop_for(&target)).expect("the crop serialises");
-    let services = doc["service"].as_array_mut().expect("services");
-    let ingest = services[1].as_table_mut().expect("a table");
-    ingest.insert("config".into(), crop);
-    let text = toml::to_string(&doc).expect("the descriptor serialises");
     let path = dir.join("frame-path.toml");
     std::fs::write(&path, text).expect("writing the descriptor");
     path

@@ -5,18 +5,20 @@ use indicatif::{ProgressBar, ProgressStyle};
 use spacepose_model::Target;
 use std::sync::Arc;
 
-/// A built-in target by name, or a mesh file scaled to metres.
+/// A target package: a built-in name, a package directory, or a mesh file
+/// scaled to metres (prepared on first use, `spacepose_prepare::resolve`).
 pub fn load_target(spec: &str, scale: f64) -> Result<Arc<Target>> {
     if !(scale.is_finite() && scale > 0.0) {
         bail!("--scale must be a positive number, got {scale}");
     }
-    let target = Target::resolve(spec, scale).with_context(|| {
+    let package = spacepose_prepare::resolve(spec, scale).with_context(|| {
         format!(
-            "cannot load target {spec:?} (built-in targets: {})",
+            "cannot load target {spec:?} (built-in targets: {}; or a package directory or a \
+             mesh file)",
             Target::BUILTIN.join(", ")
         )
     })?;
-    Ok(Arc::new(target))
+    Ok(Arc::new(package.target))
 }
 
 /// A progress bar on stderr (hidden when stderr is not a terminal).

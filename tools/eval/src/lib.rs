@@ -19,6 +19,7 @@ pub mod sim;
 pub mod stats;
 pub mod table;
 pub mod tables;
+pub mod target;
 pub mod tm;
 pub mod tracking;
 pub mod truth_csv;

@@ -44,6 +44,9 @@ pub enum Command {
     Demo(DemoArgs),
     /// Ground tool: telemetry over zenoh as a live table, optionally recorded.
     Ground(GroundArgs),
+    /// Target packages: prepare a mesh into one, or show one.
+    #[command(subcommand)]
+    Target(spacepose_eval::target::TargetCommand),
     /// Derive thresholds from simulated runs.
     #[command(subcommand)]
     Calibrate(spacepose_eval::calibrate::CalibrateCommand),

@@ -17,6 +17,7 @@ fn main() -> ExitCode {
         Command::Eval(EvalCommand::Cnn(args)) => spacepose_eval::cnn::run(&args),
         Command::Eval(EvalCommand::Tm(args)) => spacepose_eval::tm::run(&args),
         Command::Eval(EvalCommand::Tables(args)) => spacepose_eval::tables::run(&args),
+        Command::Target(command) => spacepose_eval::target::run(&command),
         Command::Calibrate(command) => spacepose_eval::calibrate::run(&command),
         Command::Up(args) => spacepose::suite::cmd::up(&args),
         Command::Supervise(args) => spacepose::suite::cmd::supervise(&args),

@@ -4,8 +4,12 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 fn spacepose(args: &[&str]) -> Output {
+    // A mesh given as a target is prepared into a package on first use: keep
+    // that cache out of the user's home.
+    let cache = std::env::temp_dir().join(format!("spacepose-sim-cli-{}", std::process::id()));
     Command::new(env!("CARGO_BIN_EXE_spacepose"))
         .args(args)
+        .env("SPACEPOSE_CACHE_DIR", cache)
         .output()
         .expect("spawn spacepose")
 }

@@ -23,7 +23,7 @@ impl Node for IngestNode {
 
     fn new(config: IngestServiceConfig, _: &NodeInfo) -> anyhow::Result<Self> {
         Ok(IngestNode {
-            stage: IngestStage::new(config.0)?,
+            stage: IngestStage::new(config.crop_config()?)?,
             prediction: None,
             buffer: Vec::new(),
             target_seen: true,

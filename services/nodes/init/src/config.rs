@@ -11,7 +11,6 @@ use serde::{Deserialize, Serialize};
 use spacepose_acquisition::TemplateMatchingConfig;
 use spacepose_lidar_sim::SensorConfig;
 use spacepose_messages::Name;
-use spacepose_model::Target;
 use spacepose_runtime::ServiceConfig;
 use std::sync::Arc;
 
@@ -29,7 +28,8 @@ pub enum MethodKind {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct InitServiceConfig {
-    /// Target: a built-in name (`"deos"`, `"envisat"`) or a mesh file.
+    /// Target: a built-in name (`"deos"`, `"envisat"`), a package directory
+    /// (`spacepose target prepare`) or a mesh file (prepared on first use).
     pub target: String,
     /// Scale applied to a mesh file.
     pub target_scale: f64,
@@ -120,8 +120,9 @@ impl InitServiceConfig {
 
     /// Resolves the target and builds every configured method, in order.
     pub fn build_chain(&self) -> Result<MethodChain, InitError> {
-        let target = Target::resolve(&self.target, self.target_scale)
-            .map_err(|e| InitError::InvalidConfig(format!("target {:?}: {e}", self.target)))?;
+        let target = spacepose_prepare::resolve(&self.target, self.target_scale)
+            .map_err(|e| InitError::InvalidConfig(format!("target {:?}: {e}", self.target)))?
+            .target;
         let target = Arc::new(target);
         let mut methods: Vec<Box<dyn PoseAcquirer>> = Vec::new();
         for kind in &self.methods {

@@ -4,7 +4,6 @@
 use anyhow::Context;
 use serde::Deserialize;
 use spacepose_lidar_sim::{FrameSource, SensorConfig};
-use spacepose_model::Target;
 use spacepose_runtime::ServiceConfig;
 use spacepose_scenario::{LookAway, ScenarioConfig, ScenarioKind};
 use std::path::PathBuf;
@@ -118,8 +117,9 @@ impl LidarSimConfig {
     /// # Errors
     /// A target that cannot be loaded, an invalid scenario or sensor.
     pub fn frame_source(&self) -> anyhow::Result<FrameSource> {
-        let target = Target::resolve(&self.target, self.scale)
-            .with_context(|| format!("cannot load target {:?}", self.target))?;
+        let target = spacepose_prepare::resolve(&self.target, self.scale)
+            .with_context(|| format!("cannot load target {:?}", self.target))?
+            .target;
         let mut sc = ScenarioConfig::default_for(self.scenario);
         sc.seed = self.seed;
         sc.compression = self.compression;

@@ -3,17 +3,18 @@
 
 use serde::{Deserialize, Serialize};
 use spacepose_messages::{MAX_POINTS, Name};
-use spacepose_model::Target;
 use spacepose_registration::{NdtMap, NdtMapParams};
 use spacepose_runtime::ServiceConfig;
-use spacepose_tracker::{TrackError, TrackerConfig, TrackingModel};
+use spacepose_tracker::{TargetThresholds, TrackError, TrackerConfig, TrackingModel};
 use std::path::{Path, PathBuf};
 
 /// The tracker service's TOML file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct TrackerServiceConfig {
-    /// Target: a built-in name (`"deos"`, `"envisat"`) or a mesh file (STL/OBJ/PLY).
+    /// Target: a built-in name (`"deos"`, `"envisat"`), a package
+    /// directory (`spacepose target prepare`), or a mesh file (STL/OBJ/PLY,
+    /// prepared into the cache on first use).
     pub target: String,
     /// Scale applied to a mesh file (e.g. 0.001 for a model in mm).
     pub target_scale: f64,
@@ -100,24 +101,27 @@ impl TrackerServiceConfig {
     /// the NDT map (seed 000 §3.1); the ICP model is built on first use
     /// (`TrackingModel::icp`), at start only in `icp` mode.
     pub fn build_model(&self) -> Result<(TrackingModel, MapSource), TrackError> {
-        let target = Target::resolve(&self.target, self.target_scale)
+        let package = spacepose_prepare::resolve(&self.target, self.target_scale)
             .map_err(|e| TrackError::Model(format!("target {:?}: {e}", self.target)))?;
-        let model_target = target.sample_surface(self.model_spacing_m, self.model_seed);
+        let thresholds = TargetThresholds::from(&package.manifest.calibration);
+        let model_target = package
+            .target
+            .sample_surface(self.model_spacing_m, self.model_seed);
         let params = NdtMapParams::default();
         let Some(path) = &self.map_file else {
             return Ok((
-                TrackingModel::build(&model_target, &params)?,
+                TrackingModel::build(&model_target, &params)?.with_thresholds(thresholds),
                 MapSource::Built,
             ));
         };
         if path.exists() {
             let map = load_map(path, &params)?;
             return Ok((
-                TrackingModel::from_map(map, &model_target),
+                TrackingModel::from_map(map, &model_target).with_thresholds(thresholds),
                 MapSource::Loaded(path.clone()),
             ));
         }
-        let model = TrackingModel::build(&model_target, &params)?;
+        let model = TrackingModel::build(&model_target, &params)?.with_thresholds(thresholds);
         model
             .map
             .save(path)

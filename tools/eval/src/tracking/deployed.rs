@@ -9,12 +9,10 @@
 use anyhow::{Context, Result};
 use spacepose_filter_node::{FilterNode, FilterServiceConfig};
 use spacepose_geometry::Point;
-use spacepose_ingest::{AxisBox, IngestConfig};
 use spacepose_ingest_node::{IngestNode, IngestServiceConfig};
 use spacepose_messages::{
     AcquisitionResult, CloudHeader, Message, Name, Names, PoseEstimate, Topic,
 };
-use spacepose_model::Target;
 use spacepose_runtime::{Envelope, LocalBus, Node, NodeInfo};
 use spacepose_tracker::{TrackOutput, TrackingModel};
 use spacepose_tracker_node::{TrackerNode, TrackerServiceConfig};
@@ -29,26 +27,6 @@ pub struct SuiteConfigs {
     pub tracker: TrackerServiceConfig,
     /// The filter's.
     pub filter: FilterServiceConfig,
-}
-
-/// The crop of `target`: its bounding sphere about the centre of mass and
-/// its body box from the mesh, with ingest's default margins. (A deployment
-/// writes the same numbers in its descriptor; `deploy/demo.toml` rounds
-/// deos' outward to the centimetre.)
-pub fn crop_for(target: &Target) -> IngestConfig {
-    let mut min_m = [f64::INFINITY; 3];
-    let mut max_m = [f64::NEG_INFINITY; 3];
-    for v in target.mesh().vertices() {
-        for i in 0..3 {
-            min_m[i] = min_m[i].min(v[i]);
-            max_m[i] = max_m[i].max(v[i]);
-        }
-    }
-    IngestConfig {
-        target_bounding_radius_m: target.bounding_radius(),
-        body_box: Some(AxisBox { min_m, max_m }),
-        ..IngestConfig::default()
-    }
 }
 
 /// What the suite answered for one frame.

@@ -29,13 +29,12 @@ mod render;
 pub mod report;
 
 pub use args::{EvalTrackingArgs, Modes};
-pub use deployed::{DeployedSuite, SuiteConfigs, crop_for};
+pub use deployed::{DeployedSuite, SuiteConfigs};
 pub use report::{DIVERGED_DEG, DIVERGED_M, FrameRecord, ModeReport, TrackingReport};
 
 use crate::common::{load_target, progress_bar};
 use crate::stats::MeanMax;
 use anyhow::{Context, Result, bail};
-use spacepose_ingest::IngestConfig;
 use spacepose_ingest_node::IngestServiceConfig;
 use spacepose_lidar_sim::FrameSource;
 use spacepose_lidar_sim_node::LidarSimConfig;
@@ -74,8 +73,9 @@ pub struct EvalConfig {
     pub ct_start: Option<spacepose_tracker::CtStart>,
     /// Base tracker configuration (the defaults when `None`).
     pub tracker: Option<TrackerConfig>,
-    /// Ingest's configuration (default: [`crop_for`] the target).
-    pub ingest: Option<IngestConfig>,
+    /// Ingest's configuration (default: the service's, on this target, whose
+    /// package gives the crop region).
+    pub ingest: Option<IngestServiceConfig>,
 }
 
 /// Runs the evaluation.
@@ -98,7 +98,7 @@ pub fn evaluate(config: &EvalConfig) -> Result<TrackingReport> {
             config.first_frame
         );
     }
-    let base = suite_configs(config, &target)?;
+    let base = suite_configs(config)?;
     let (model, _) = base.tracker.build_model().context("building the NDT map")?;
     let mut suites = config
         .modes
@@ -130,7 +130,7 @@ fn frame_source(config: &EvalConfig) -> Result<FrameSource> {
 
 /// The services' configurations: the defaults, the target's crop, and the
 /// tracker options of `config` (the mode is set per suite).
-fn suite_configs(config: &EvalConfig, target: &spacepose_model::Target) -> Result<SuiteConfigs> {
+fn suite_configs(config: &EvalConfig) -> Result<SuiteConfigs> {
     let mut tracker = config.tracker.clone().unwrap_or_default();
     if let Some(lever) = config.min_lever_arm_m {
         tracker.ndt.min_lever_arm_m = lever;
@@ -142,9 +142,16 @@ fn suite_configs(config: &EvalConfig, target: &spacepose_model::Target) -> Resul
     if let Some(start) = config.ct_start {
         tracker.ct_start = start;
     }
-    let ingest = config.ingest.clone().unwrap_or_else(|| crop_for(target));
+    let ingest = config
+        .ingest
+        .clone()
+        .unwrap_or_else(|| IngestServiceConfig {
+            target: config.target.0.clone(),
+            target_scale: config.target.1,
+            ..IngestServiceConfig::default()
+        });
     Ok(SuiteConfigs {
-        ingest: IngestServiceConfig(ingest),
+        ingest,
         tracker: TrackerServiceConfig {
             target: config.target.0.clone(),
             target_scale: config.target.1,
