@@ -20,14 +20,5 @@ for s in $(echo $seeds | cut -d' ' -f1-5); do
       --json "$out/$scenario-$s.json" >/dev/null
   done
 done
-# Keep the summaries and, of each frame, its status and errors (the full
-# series are ~1 MB a run; rerun with --json to see them).
-for f in "$out"/*.json; do
-  python3 -c 'import json,sys
-r = json.load(open(sys.argv[1]))
-keep = ("frame", "status", "ang_err_deg", "pos_err_cm")
-rnd = lambda v: round(v, 5) if isinstance(v, float) else v
-for m in r["modes"].values():
-    m["series"] = [{k: rnd(x[k]) for k in keep} for x in m["series"]]
-json.dump(r, open(sys.argv[1], "w"), separators=(",", ":"))' "$f"
-done
+# Keep the summaries and each frame's status and errors.
+"$(dirname "$0")/reduce-runs.py" "$out"/*.json

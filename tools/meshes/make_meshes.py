@@ -13,6 +13,15 @@ the two shapes issue 24 reports failing or never tried:
   bus, two 7 m solar arrays on yokes, a 2.2 m dish on a tower, a small
   thruster block), about 17 m tip to tip.
 
+- comsat.stl: a box-wing geostationary satellite (2 x 2.2 x 3.2 m bus, two
+  four-panel wings, two reflectors), about 25 m across, metres.
+- probe.stl: a small probe (0.6 x 0.5 x 0.4 m box, 0.7 m dish, 0.7 m
+  boom), about 1.3 m across, metres.
+
+telescope and relay were used while developing target packages (their
+failures drove the length unit and the unscaled lever-arm holds); comsat
+and probe were added afterwards and only measured.
+
 Run: python3 tools/meshes/make_meshes.py (deterministic output).
 """
 import math
@@ -83,6 +92,30 @@ def relay():
     t += box([0.9, -0.7, -2.0], [0.2, 0.2, 0.2])
     return t
 
+def rot_x(deg):
+    a = math.radians(deg)
+    return [[1, 0, 0], [0, math.cos(a), -math.sin(a)], [0, math.sin(a), math.cos(a)]]
+
+def comsat():
+    """A box-wing geostationary communications satellite, about 25 m across."""
+    t = box([0, 0, 0], [1.0, 1.1, 1.6])
+    for s in (-1, 1):
+        t += box([0, s * 1.6, 0], [0.05, 0.5, 0.05])
+        for k in range(4):
+            t += box([0, s * (2.6 + 2.55 * k), 0], [1.2, 1.2, 0.02], rot_x(3.0 * s))
+    for s in (-1, 1):
+        t += [[[v[0] * s + s * 1.6, v[1], v[2] * 0.5 + 0.6] for v in tri] for tri in cone_z(0.0, 0.5, 0.1, 1.1, 20)]
+    t += box([0, 0, 1.9], [0.3, 0.3, 0.3])
+    return t
+
+def probe():
+    """A small science probe, about 1.3 m across: a box, a dish, one boom."""
+    t = box([0, 0, 0], [0.3, 0.25, 0.2])
+    t += [[[v[0], v[1], v[2] + 0.2] for v in tri] for tri in cone_z(0.0, 0.12, 0.05, 0.35, 16)]
+    t += box([0.65, 0.0, -0.1], [0.35, 0.015, 0.015])
+    t += box([-0.3, 0.2, -0.25], [0.08, 0.05, 0.05])
+    return t
+
 def write_stl(path, name, tris):
     with open(path, "w") as f:
         f.write(f"solid {name}\n")
@@ -102,3 +135,5 @@ if __name__ == "__main__":
     os.makedirs(out, exist_ok=True)
     write_stl(os.path.join(out, "telescope.stl"), "telescope", telescope())
     write_stl(os.path.join(out, "relay.stl"), "relay", relay())
+    write_stl(os.path.join(out, "comsat.stl"), "comsat", comsat())
+    write_stl(os.path.join(out, "probe.stl"), "probe", probe())

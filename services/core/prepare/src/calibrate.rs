@@ -27,7 +27,7 @@ use spacepose_model::Target;
 use spacepose_model::package::{Calibration, CalibrationRecord};
 use spacepose_registration::Registration;
 use spacepose_scenario::{ScenarioConfig, ScenarioKind, build};
-use spacepose_tracker::{Tracker, TrackerConfig, TrackingMode, TrackingModel};
+use spacepose_tracker::{REFERENCE_LENGTH_M, Tracker, TrackerConfig, TrackingMode, TrackingModel};
 use std::sync::Arc;
 
 /// How many frames, where, and with which seeds.
@@ -60,7 +60,8 @@ impl Default for CalibrationOptions {
 /// Sensor limits the ranges are kept within (m): the Mid-40's usable span.
 const RANGE_LIMITS_M: (f64, f64) = (1.5, 60.0);
 
-/// Calibrates `target`'s thresholds for the tracker's `model`;
+/// Calibrates `target`'s thresholds for the tracker's `model` (built with
+/// the package's length unit, `model.thresholds.length_scale`);
 /// `progress(done, total)` is called after each frame.
 pub fn calibrate(
     target: &Arc<Target>,
@@ -91,7 +92,8 @@ pub fn calibrate(
             progress(done, total);
         }
     }
-    summarise(samples, total, ranges, options)
+    let length_unit_m = model.thresholds.length_scale * REFERENCE_LENGTH_M;
+    summarise(samples, total, ranges, length_unit_m, options)
 }
 
 /// Ranges `f · R`, kept within [`RANGE_LIMITS_M`], deduplicated.
@@ -128,7 +130,9 @@ fn frames_at(
     {
         let truth = scenario.state_at(t_end);
         let frame = sim.simulate(&truth, &mut LidarSimulator::frame_rng(seed, k as u64));
-        let mut tracker = Tracker::new(TrackerConfig::with_mode(TrackingMode::Ndt), model.clone())?;
+        let config = TrackerConfig::with_mode(TrackingMode::Ndt)
+            .scaled_lengths(model.thresholds.length_scale);
+        let mut tracker = Tracker::new(config, model.clone())?;
         tracker.initialize(
             frame.scan_start,
             &truth.t_sensor_target,
@@ -155,6 +159,7 @@ fn summarise(
     samples: Vec<(f64, f64)>,
     frames: usize,
     ranges_m: Vec<f64>,
+    length_unit_m: f64,
     options: &CalibrationOptions,
 ) -> Result<Calibration, PrepareError> {
     if samples.len() < options.min_frames_used {
@@ -173,6 +178,7 @@ fn summarise(
     let calibration = Calibration {
         max_mean_cost_ndt: 1.5 * p99,
         min_inlier_fraction: 0.5 * p01,
+        length_unit_m,
         record: CalibrationRecord {
             frames,
             frames_used: samples.len(),

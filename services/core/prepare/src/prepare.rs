@@ -10,8 +10,7 @@ use spacepose_model::package::{
     write_package,
 };
 use spacepose_model::symmetry::{SymmetryOptions, detect_symmetries};
-use spacepose_registration::NdtMapParams;
-use spacepose_tracker::TrackingModel;
+use spacepose_tracker::{REFERENCE_LENGTH_M, TargetThresholds, TrackingModel, map_params_scaled};
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
@@ -41,9 +40,10 @@ pub struct PrepareOptions {
     pub symmetry: SymmetryChoice,
     /// The calibration's frames.
     pub calibration: CalibrationOptions,
-    /// Spacing of the model cloud the tracker samples (m): the tracker
-    /// service's `model_spacing_m` default, so that the calibration sees the
-    /// map the tracker will build.
+    /// Spacing of the model cloud the tracker samples (m) for the
+    /// reference cell: the tracker service's `model_spacing_m` default, so
+    /// that the calibration sees the map the tracker will build (both scale
+    /// it by ℓ / 7.5 cm).
     pub model_spacing_m: f64,
     /// The command line that made the package (recorded to rebuild it).
     pub command: String,
@@ -79,14 +79,20 @@ pub fn prepare(
         .unwrap_or_else(|| target.name().to_owned());
     let (group, twins, symmetry) = symmetry_of(&target, &options.symmetry)?;
     let target = Arc::new(target.with_symmetries(&name, group, twins)?);
-    let cloud = target.sample_surface(options.model_spacing_m, 0);
+    let factor = length_unit_m(target.mesh().surface_area()) / REFERENCE_LENGTH_M;
+    let cloud = target.sample_surface(options.model_spacing_m * factor, 0);
     if cloud.is_empty() {
         return Err(PrepareError::InvalidOption(format!(
             "model_spacing_m = {} gives no model cloud for this mesh",
             options.model_spacing_m
         )));
     }
-    let model = TrackingModel::build(&cloud, &NdtMapParams::default())?;
+    let thresholds = TargetThresholds {
+        length_scale: factor,
+        ..TargetThresholds::UNCALIBRATED
+    };
+    let model =
+        TrackingModel::build(&cloud, &map_params_scaled(factor))?.with_thresholds(thresholds);
     let calibration = calibrate(&target, &model, &options.calibration, progress)?;
     let provenance = Provenance {
         spacepose_version: env!("CARGO_PKG_VERSION").to_owned(),
@@ -105,6 +111,15 @@ pub fn prepare(
         manifest,
         dir: out.map(Path::to_owned),
     })
+}
+
+/// The target's NDT length unit ℓ (m) from its surface area `A` (m²):
+/// max(7.5 cm, 0.018 √A). Seed 000 Table 1's 7.5 cm cell serves a
+/// deos-sized body (17 m², 0.018 √A = 7.4 cm); a larger one keeps about as
+/// many cells across its surface (√A / ℓ ≈ 55), so the basin of the
+/// registration stays the same fraction of the target.
+pub fn length_unit_m(surface_area_m2: f64) -> f64 {
+    (0.018 * surface_area_m2.max(0.0).sqrt()).max(REFERENCE_LENGTH_M)
 }
 
 /// The target, its mesh record and the FNV-1a of its source.

@@ -39,6 +39,10 @@ pub struct TargetThresholds {
     pub max_mean_cost_ndt: f64,
     /// Smallest inlier fraction (`loss.min_inlier_fraction`).
     pub min_inlier_fraction: f64,
+    /// The target's length unit over the reference cell, ℓ / 7.5 cm
+    /// ([`crate::length_unit`]): the factor of the map's and the tracking
+    /// loop's lengths.
+    pub length_scale: f64,
 }
 
 impl TargetThresholds {
@@ -49,6 +53,7 @@ impl TargetThresholds {
     pub const UNCALIBRATED: TargetThresholds = TargetThresholds {
         max_mean_cost_ndt: 10.0,
         min_inlier_fraction: 0.3,
+        length_scale: 1.0,
     };
 }
 
@@ -57,6 +62,7 @@ impl From<&spacepose_model::package::Calibration> for TargetThresholds {
         TargetThresholds {
             max_mean_cost_ndt: c.max_mean_cost_ndt,
             min_inlier_fraction: c.min_inlier_fraction,
+            length_scale: c.length_unit_m / crate::length_unit::REFERENCE_LENGTH_M,
         }
     }
 }

@@ -5,7 +5,9 @@ use serde::{Deserialize, Serialize};
 use spacepose_messages::{MAX_POINTS, Name};
 use spacepose_registration::{NdtMap, NdtMapParams};
 use spacepose_runtime::ServiceConfig;
-use spacepose_tracker::{TargetThresholds, TrackError, TrackerConfig, TrackingModel};
+use spacepose_tracker::{
+    TargetThresholds, TrackError, TrackerConfig, TrackingModel, map_params_scaled,
+};
 use std::path::{Path, PathBuf};
 
 /// The tracker service's TOML file.
@@ -18,7 +20,9 @@ pub struct TrackerServiceConfig {
     pub target: String,
     /// Scale applied to a mesh file (e.g. 0.001 for a model in mm).
     pub target_scale: f64,
-    /// Spacing of the model cloud sampled on the target surface (m).
+    /// Spacing of the model cloud sampled on the target surface (m), for
+    /// the reference 7.5 cm cell: multiplied by the target's ℓ / 7.5 cm
+    /// (`spacepose_tracker::length_unit`; 1 for deos).
     pub model_spacing_m: f64,
     /// Seed of the surface sampling.
     pub model_seed: u64,
@@ -104,10 +108,11 @@ impl TrackerServiceConfig {
         let package = spacepose_prepare::resolve(&self.target, self.target_scale)
             .map_err(|e| TrackError::Model(format!("target {:?}: {e}", self.target)))?;
         let thresholds = TargetThresholds::from(&package.manifest.calibration);
+        let factor = thresholds.length_scale;
         let model_target = package
             .target
-            .sample_surface(self.model_spacing_m, self.model_seed);
-        let params = NdtMapParams::default();
+            .sample_surface(self.model_spacing_m * factor, self.model_seed);
+        let params = map_params_scaled(factor);
         let Some(path) = &self.map_file else {
             return Ok((
                 TrackingModel::build(&model_target, &params)?.with_thresholds(thresholds),

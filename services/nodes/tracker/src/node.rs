@@ -116,6 +116,9 @@ impl TrackerNode {
         instance: Name,
         max_points: usize,
     ) -> Result<Self, TrackError> {
+        // The configured lengths are for the reference cell; the target's
+        // package scales them (`spacepose_tracker::length_unit`).
+        let config = config.scaled_lengths(model.thresholds.length_scale);
         Ok(TrackerNode {
             track: Track::new(config, model)?,
             instance,

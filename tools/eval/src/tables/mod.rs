@@ -9,7 +9,7 @@
 pub mod runs;
 
 use anyhow::{Context, Result, bail};
-use runs::{Pooled, Pools, load_dir, pool};
+use runs::{Pooled, Pools, load_dir, pool, pool_by};
 use std::path::{Path, PathBuf};
 
 /// Arguments of `spacepose eval tables`.
@@ -28,11 +28,15 @@ pub const BLIND_RUNS: &str = "docs/results/tracking-blind";
 /// The same runs by the CLI before the one-frame-path change.
 pub const FRAME_PATH_BEFORE_RUNS: &str = "docs/results/frame-path-before";
 
+/// Runs on the other targets (`docs/results/measure-targets.sh`).
+pub const TARGET_RUNS: &str = "docs/results/targets";
+
 /// `(file, block name)` of every generated table.
-pub const BLOCKS: [(&str, &str); 3] = [
+pub const BLOCKS: [(&str, &str); 4] = [
     ("README.md", "headline"),
     ("docs/results.md", "tracking-blind"),
     ("docs/design/frame-path.md", "frame-path"),
+    ("docs/design/target-packages.md", "targets"),
 ];
 
 /// Runs the command.
@@ -55,11 +59,13 @@ pub fn run(args: &TablesArgs) -> Result<()> {
 pub fn update(root: &Path, write: bool) -> Result<Vec<String>> {
     let blind = pool(&load_dir(&root.join(BLIND_RUNS))?);
     let before = pool(&load_dir(&root.join(FRAME_PATH_BEFORE_RUNS))?);
+    let targets = pool_by(&load_dir(&root.join(TARGET_RUNS))?, |r| r.target.clone());
     let mut stale = Vec::new();
     for (file, name) in BLOCKS {
         let body = match name {
             "headline" => headline(&blind),
             "tracking-blind" => full(&blind),
+            "targets" => by_target(&targets),
             _ => comparison(&before, &blind),
         };
         let path = root.join(file);
@@ -134,6 +140,35 @@ fn full(pools: &Pools) -> String {
                 "| {scenario} | {mode} | {} | {} | {} / {} / {} | {} / {} / {} | {} | {} | {} |\n",
                 p.seeds,
                 p.frames,
+                fmt(p.ang_deg[0], 2),
+                fmt(p.ang_deg[1], 2),
+                fmt(p.ang_deg[2], 2),
+                fmt(p.pos_cm[0], 1),
+                fmt(p.pos_cm[1], 1),
+                fmt(p.pos_cm[2], 1),
+                p.lost,
+                p.diverged,
+                p.silent
+            ));
+        }
+    }
+    out
+}
+
+/// The target-packages note's table: every target (tumbling, blind seeds).
+fn by_target(pools: &Pools) -> String {
+    let p = pools.values().flat_map(|m| m.values()).next();
+    let (seeds, frames) = p.map_or((0, 0), |p| (p.seeds, p.frames));
+    let mut out = format!(
+        "tumbling, {seeds} blind seeds, {frames} frames per target and mode after the warm-up; \
+         errors pooled over every frame\n\n"
+    );
+    out.push_str("| target | mode | angle p50 / p95 / max (°) | position p50 / p95 / max (cm) | lost | diverged | silent |\n");
+    out.push_str("|---|---|---|---|---|---|---|\n");
+    for (target, modes) in pools {
+        for (mode, p) in modes {
+            out.push_str(&format!(
+                "| {target} | {mode} | {} / {} / {} | {} / {} / {} | {} | {} | {} |\n",
                 fmt(p.ang_deg[0], 2),
                 fmt(p.ang_deg[1], 2),
                 fmt(p.ang_deg[2], 2),

@@ -33,6 +33,8 @@ pub struct ModeRun {
 pub struct Run {
     /// Scenario name.
     pub scenario: String,
+    /// Target name.
+    pub target: String,
     /// Seed.
     pub seed: u64,
     /// Frames excluded from the converged statistics.
@@ -81,17 +83,20 @@ pub struct Pooled {
     pub silent: usize,
 }
 
-/// Scenario → mode → pooled statistics.
+/// Scenario (or target) → mode → pooled statistics.
 pub type Pools = BTreeMap<String, BTreeMap<String, Pooled>>;
 
 /// Pools `runs` by scenario and mode.
 pub fn pool(runs: &[Run]) -> Pools {
+    pool_by(runs, |r| r.scenario.clone())
+}
+
+/// Pools `runs` by `key` (e.g. the target) and mode.
+pub fn pool_by(runs: &[Run], key: impl Fn(&Run) -> String) -> Pools {
     let mut frames: BTreeMap<(String, String), (usize, Vec<FrameErr>)> = BTreeMap::new();
     for run in runs {
         for (mode, m) in &run.modes {
-            let entry = frames
-                .entry((run.scenario.clone(), mode.clone()))
-                .or_default();
+            let entry = frames.entry((key(run), mode.clone())).or_default();
             entry.0 += 1;
             let after = m.series.iter().filter(|f| f.frame >= run.warmup).cloned();
             entry.1.extend(after);
@@ -181,6 +186,7 @@ mod tests {
         ];
         let run = Run {
             scenario: "tumbling".into(),
+            target: "deos".into(),
             seed: 1,
             warmup: 1,
             modes: BTreeMap::from([("ndt".to_string(), ModeRun { series })]),

@@ -108,6 +108,10 @@ pub struct Calibration {
     /// Smallest fraction of the filtered points that must find a cell:
     /// tracker `loss.min_inlier_fraction`.
     pub min_inlier_fraction: f64,
+    /// The target's NDT length unit ℓ (m): max(7.5 cm, 0.018 √A) with A
+    /// the surface area; the tracker's map and loop lengths are given for
+    /// 7.5 cm and multiplied by ℓ / 7.5 cm (`spacepose_tracker::length_unit`).
+    pub length_unit_m: f64,
     /// The figures the thresholds were derived from.
     pub record: CalibrationRecord,
 }
@@ -263,6 +267,12 @@ impl Calibration {
             return Err(TargetError::InvalidPackage(format!(
                 "calibration.max_mean_cost_ndt = {} must be finite and > 0",
                 c.max_mean_cost_ndt
+            )));
+        }
+        if !(c.length_unit_m.is_finite() && c.length_unit_m > 0.0) {
+            return Err(TargetError::InvalidPackage(format!(
+                "calibration.length_unit_m = {} must be finite and > 0",
+                c.length_unit_m
             )));
         }
         if !(c.min_inlier_fraction.is_finite() && (0.0..=1.0).contains(&c.min_inlier_fraction)) {

@@ -16,6 +16,7 @@ fn manifest_of(t: &Target) -> PackageManifest {
         Calibration {
             max_mean_cost_ndt: 9.5,
             min_inlier_fraction: 0.25,
+            length_unit_m: 0.075,
             record: CalibrationRecord {
                 frames: 10,
                 frames_used: 9,
