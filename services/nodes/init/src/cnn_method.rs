@@ -90,7 +90,7 @@ impl CnnMethodConfig {
 
 /// `dir` itself when it exists or is absolute, else `dir` under the source
 /// tree's root when it exists there, else `dir` (whose error names it).
-fn resolve_model_dir(dir: &Path) -> PathBuf {
+pub(crate) fn resolve_model_dir(dir: &Path) -> PathBuf {
     if dir.is_absolute() || dir.exists() {
         return dir.to_path_buf();
     }

@@ -132,12 +132,39 @@ impl InitServiceConfig {
                     self.sensor(),
                     self.template_matching.clone(),
                 )?)),
-                MethodKind::Cnn => {
-                    methods.push(Box::new(CnnMethod::new(target.clone(), &self.cnn)?));
-                }
+                MethodKind::Cnn => match self.cnn_unavailable(target.name()) {
+                    Some(why) if self.methods.contains(&MethodKind::TemplateMatching) => {
+                        tracing::warn!(
+                            target = target.name(),
+                            "no CNN for this target ({why}): acquiring by template matching alone"
+                        );
+                    }
+                    _ => methods.push(Box::new(CnnMethod::new(target.clone(), &self.cnn)?)),
+                },
             }
         }
         MethodChain::new(methods, self.min_points)?.with_voxels(self.leaf_size_m)
+    }
+}
+
+impl InitServiceConfig {
+    /// Why the configured CNN cannot serve `target`: no model in
+    /// `cnn.model_dir`, or a model trained for another target. `None` when
+    /// it can (a model that is there but broken is left to the loader, whose
+    /// error stops the service).
+    pub fn cnn_unavailable(&self, target: &str) -> Option<String> {
+        let dir = crate::cnn_method::resolve_model_dir(&self.cnn.model_dir);
+        if !dir.join(spacepose_cnn::model_meta::MODEL_JSON).is_file() {
+            return Some(format!("no model in {}", dir.display()));
+        }
+        match spacepose_cnn::model_meta::ModelMeta::read(&dir) {
+            Ok(meta) if meta.target != target => Some(format!(
+                "the model in {} was trained for {}",
+                dir.display(),
+                meta.target
+            )),
+            _ => None,
+        }
     }
 }
 
@@ -278,5 +305,39 @@ mod tests {
         ] {
             assert!(c.validate().is_err(), "{c:?}");
         }
+    }
+
+    #[test]
+    fn a_target_without_a_cnn_acquires_by_template_matching_alone() {
+        let both = InitServiceConfig {
+            target: "envisat".into(),
+            methods: vec![MethodKind::Cnn, MethodKind::TemplateMatching],
+            ..InitServiceConfig::default()
+        };
+        let why = both
+            .cnn_unavailable("envisat")
+            .expect("the model is deos's");
+        assert!(why.contains("trained for deos"), "{why}");
+        assert_eq!(both.cnn_unavailable("deos"), None);
+        let chain = both.build_chain().expect("template matching alone");
+        let tm = spacepose_messages::AcquisitionMethod::TemplateMatching;
+        assert_eq!(chain.methods(), vec![tm]);
+
+        let cnn_only = InitServiceConfig {
+            methods: vec![MethodKind::Cnn],
+            ..both.clone()
+        };
+        let e = cnn_only.build_chain().err().expect("no method left");
+        assert!(e.to_string().contains("deos"), "{e}");
+
+        let missing = InitServiceConfig {
+            cnn: CnnMethodConfig {
+                model_dir: "/nonexistent/model".into(),
+                ..CnnMethodConfig::default()
+            },
+            ..both
+        };
+        let why = missing.cnn_unavailable("envisat").expect("no model");
+        assert!(why.contains("/nonexistent/model"), "{why}");
     }
 }

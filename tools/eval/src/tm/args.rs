@@ -42,6 +42,10 @@ pub struct TmOptions {
     /// Sensor effects of the simulated frames.
     #[arg(long, value_enum, default_value_t = SensorEffects::All)]
     pub sensor_effects: SensorEffects,
+    /// The sensor: seed 002's raster, or the suite's Livox Mid-40 with the
+    /// init service's 2 cm voxel filter (the path the suite runs).
+    #[arg(long, value_enum, default_value_t = TmSensor::Raster)]
+    pub sensor: TmSensor,
     /// Position from the trimmed centroid (seed 004) instead of the mean.
     #[arg(long)]
     pub trimmed: bool,
@@ -228,6 +232,36 @@ pub enum SensorEffects {
     /// line-of-sight noise, outliers at 4 σ_RANGE; no beam divergence
     /// (mixed returns), no reflections, no motion blur.
     Seed002,
+}
+
+/// `eval tm --sensor`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TmSensor {
+    /// Seed 002 §4.1's raster (40° × 40° at 1°).
+    Raster,
+    /// The Livox Mid-40 rosette (0.54 s, ~54,000 rays), frames
+    /// voxel-filtered at 2 cm as the init service does (`leaf_size_m`).
+    Mid40,
+}
+
+impl TmSensor {
+    /// The sensor model.
+    pub fn config(self) -> spacepose_lidar_sim::SensorConfig {
+        match self {
+            TmSensor::Raster => spacepose_lidar_sim::SensorConfig::raster_seed002(),
+            TmSensor::Mid40 => spacepose_lidar_sim::SensorConfig::livox_mid40(),
+        }
+    }
+
+    /// The voxel leaf applied before matching (m): the init service's
+    /// default for the Mid-40, none for the raster (seed 002).
+    pub fn voxel_leaf_m(self) -> Option<f64> {
+        match self {
+            TmSensor::Raster => None,
+            TmSensor::Mid40 => Some(0.02),
+        }
+    }
 }
 
 impl SensorEffects {

@@ -3,7 +3,8 @@
 //! Fig. 8, Tables 2 and 4).
 //!
 //! Conditions: the raster sensor of seed 002 §4.1 (40°×40° at 1°,
-//! [`SensorConfig::raster_seed002`]) with every effect on but facility
+//! `SensorConfig::raster_seed002`), or with `--sensor mid40` the suite's
+//! Livox Mid-40 and the init service's 2 cm voxel filter, with every effect on but facility
 //! clutter (noise, line-of-sight error, outliers, detection losses, beam
 //! divergence, reflections, motion blur). A solution is a success when the
 //! attitude error after ICP is below 3° (§4.2), with d_sym (seed 004
@@ -19,7 +20,7 @@ mod render;
 mod report;
 mod scoring;
 
-pub use args::{EvalTmArgs, SensorEffects, TmOptions};
+pub use args::{EvalTmArgs, SensorEffects, TmOptions, TmSensor};
 pub use report::{TemplateCounts, TmFrame, TmReport};
 pub use scoring::SUCCESS_DEG;
 
@@ -29,7 +30,8 @@ use anyhow::{Context, Result, bail};
 use rayon::prelude::*;
 use scoring::{score, summarise};
 use spacepose_acquisition::TemplateMatcher;
-use spacepose_lidar_sim::{Frame, LidarSimulator, SensorConfig};
+use spacepose_geometry::voxel_filter;
+use spacepose_lidar_sim::{Frame, LidarSimulator};
 use spacepose_scenario::ScenarioKind;
 use spacepose_scenario::{ScenarioConfig, build};
 
@@ -39,7 +41,7 @@ pub fn evaluate(scenario_arg: ScenarioKind, options: &TmOptions) -> Result<TmRep
         bail!("template matching is evaluated on random or ellipse (seed 002 §4.3)");
     }
     let target = load_target(&options.target, options.scale)?;
-    let sensor = SensorConfig::raster_seed002();
+    let sensor = options.sensor.config();
     let matching = options.matching()?;
     let matcher = TemplateMatcher::new(target.clone(), sensor.clone(), matching.clone())
         .context("building the template matcher")?;
@@ -72,7 +74,13 @@ pub fn evaluate(scenario_arg: ScenarioKind, options: &TmOptions) -> Result<TmRep
             })
             .collect();
         for (i, frame) in simulated.iter().enumerate() {
-            let result = matcher.acquire(&frame.points);
+            let points = match options.sensor.voxel_leaf_m() {
+                Some(leaf) => voxel_filter(&frame.points, leaf)
+                    .map(|v| v.points)
+                    .context("voxel filter")?,
+                None => frame.points.clone(),
+            };
+            let result = matcher.acquire(&points);
             frames.push(score(b * 16 + i, frame, result, target.symmetries()));
             bar.inc(1);
         }

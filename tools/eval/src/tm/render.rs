@@ -17,7 +17,7 @@ pub fn header(report: &TmReport) -> String {
         report.scenario,
         range_suffix(report.range_m),
         report.seed,
-        effects_suffix(report.sensor_effects),
+        sensor_suffix(report.sensor, report.sensor_effects),
         report.count,
         c.delta_deg,
         fast_label(c),
@@ -26,6 +26,15 @@ pub fn header(report: &TmReport) -> String {
         c.icp_candidates,
         report.mean_points,
     )
+}
+
+/// The sensor (when not seed 002's raster) and its effects.
+fn sensor_suffix(sensor: super::TmSensor, effects: SensorEffects) -> String {
+    let name = match sensor {
+        super::TmSensor::Raster => "",
+        super::TmSensor::Mid40 => " / Mid-40, 2 cm voxels",
+    };
+    format!("{name}{}", effects_suffix(effects))
 }
 
 /// " at R m" for a fixed-range scenario (finite range), empty otherwise.

@@ -75,6 +75,8 @@ pub struct TmReport {
     pub seed: u64,
     /// Sensor effects of the frames.
     pub sensor_effects: SensorEffects,
+    /// The sensor.
+    pub sensor: super::TmSensor,
     /// Frames.
     pub count: usize,
     /// Matching configuration.

@@ -121,6 +121,7 @@ pub fn summarise(
         },
         seed: options.seed,
         sensor_effects: options.sensor_effects,
+        sensor: options.sensor,
         count: frames.len(),
         config,
         success_rate: ok.len() as f64 / n,
