@@ -28,9 +28,7 @@
 use crate::config::TrackerConfig;
 use spacepose_registration::NdtMapParams;
 
-/// The cell size of seed 000 Table 1 (m): the length unit the configured
-/// lengths are given for.
-pub const REFERENCE_LENGTH_M: f64 = 0.075;
+pub use crate::model::REFERENCE_LENGTH_M;
 
 impl TrackerConfig {
     /// This configuration with its map-related lengths multiplied by

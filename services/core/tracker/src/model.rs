@@ -30,6 +30,10 @@ pub struct TrackingModel {
     icp: Arc<LazyIcp>,
 }
 
+/// The cell size of seed 000 Table 1 (m): the length unit the configured
+/// lengths are given for ([`crate::length_unit`]).
+pub const REFERENCE_LENGTH_M: f64 = 0.075;
+
 /// The loss thresholds that depend on the target's shape, calibrated per
 /// target from simulated frames when its package is prepared (crate
 /// `spacepose-prepare`; `docs/design/target-packages.md`).
@@ -62,7 +66,7 @@ impl From<&spacepose_model::package::Calibration> for TargetThresholds {
         TargetThresholds {
             max_mean_cost_ndt: c.max_mean_cost_ndt,
             min_inlier_fraction: c.min_inlier_fraction,
-            length_scale: c.length_unit_m / crate::length_unit::REFERENCE_LENGTH_M,
+            length_scale: c.length_unit_m / REFERENCE_LENGTH_M,
         }
     }
 }
