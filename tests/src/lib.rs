@@ -57,7 +57,11 @@ pub fn require_suite() -> PathBuf {
 
 /// Root of the repository (for `deploy/*.toml`).
 pub fn repo_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
+    // The manifest directory cargo gives the test at run time, so a test
+    // binary reused from another checkout's build reads this checkout.
+    let dir = std::env::var("CARGO_MANIFEST_DIR")
+        .unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned());
+    Path::new(&dir)
         .parent()
         .expect("tests/ is inside the repository")
         .to_path_buf()

@@ -2,8 +2,20 @@ use super::*;
 use crate::dataset::{DEFAULT_MIN_POINTS, DatasetConfig, Generator};
 use spacepose_geometry::so3;
 
-const FIXTURE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/fixed_deos");
-const DEOS_MODEL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/models/deos");
+/// The crate directory cargo gives the test at run time.
+fn crate_dir() -> std::path::PathBuf {
+    std::env::var("CARGO_MANIFEST_DIR")
+        .unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned())
+        .into()
+}
+
+fn fixture_dir() -> std::path::PathBuf {
+    crate_dir().join("fixtures/fixed_deos")
+}
+
+fn deos_model_dir() -> std::path::PathBuf {
+    crate_dir().join("models/deos")
+}
 
 fn deos() -> Arc<Target> {
     Arc::new(Target::builtin("deos").unwrap())
@@ -12,7 +24,7 @@ fn deos() -> Arc<Target> {
 /// A copy of the fixture whose model.json is edited by `edit`.
 fn fixture_copy(edit: impl FnOnce(&mut serde_json::Value)) -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
-    let src = Path::new(FIXTURE);
+    let src = fixture_dir();
     std::fs::copy(src.join("model.onnx"), dir.path().join("model.onnx")).unwrap();
     let mut meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(src.join("model.json")).unwrap()).unwrap();
@@ -50,7 +62,7 @@ fn missing_directory_or_files_are_clear_errors() {
     assert!(err.to_string().contains("model.onnx"), "{err}");
     // model.onnx without model.json.
     std::fs::copy(
-        Path::new(FIXTURE).join("model.onnx"),
+        fixture_dir().join("model.onnx"),
         empty.path().join("model.onnx"),
     )
     .unwrap();
@@ -86,7 +98,7 @@ fn mismatched_model_is_refused_naming_the_field() {
 
 #[test]
 fn sparse_and_all_nan_clouds_are_errors_and_a_frame_gives_consistent_figures() {
-    let estimator = load(Path::new(FIXTURE)).unwrap();
+    let estimator = load(&fixture_dir()).unwrap();
     assert_eq!(estimator.classes().len(), 618);
     let frame = &held_out(1001, 1)[0];
     let sparse = &frame.points[..MIN_POINTS - 1];
@@ -120,11 +132,14 @@ fn sparse_and_all_nan_clouds_are_errors_and_a_frame_gives_consistent_figures() {
 
 #[test]
 fn real_model_acquires_held_out_frames() {
-    if !Path::new(DEOS_MODEL).join("model.onnx").is_file() {
-        println!("skipped: no trained model at {DEOS_MODEL}/model.onnx");
+    if !deos_model_dir().join("model.onnx").is_file() {
+        println!(
+            "skipped: no trained model in {}",
+            deos_model_dir().display()
+        );
         return;
     }
-    let estimator = load(Path::new(DEOS_MODEL)).unwrap();
+    let estimator = load(&deos_model_dir()).unwrap();
     let frames = held_out(1002, 10);
     let mut ok = 0;
     for (i, f) in frames.iter().enumerate() {

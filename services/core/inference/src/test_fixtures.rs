@@ -9,10 +9,16 @@ use crate::contract::ModelShape;
 /// Largest difference allowed from onnxruntime's outputs.
 pub(crate) const TOLERANCE: f32 = 1e-5;
 
+/// The file `name` under `fixtures/`, found from the manifest directory
+/// cargo gives the test at run time (a test binary reused from a build in
+/// another checkout would otherwise look in that checkout).
 pub(crate) fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("fixtures")
-        .join(name)
+    PathBuf::from(
+        std::env::var("CARGO_MANIFEST_DIR")
+            .unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned()),
+    )
+    .join("fixtures")
+    .join(name)
 }
 
 pub(crate) fn tiny() -> PathBuf {

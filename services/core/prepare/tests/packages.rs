@@ -8,7 +8,11 @@ use spacepose_prepare::{builtin_package, resolve, resolve_in};
 use std::path::{Path, PathBuf};
 
 fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../..")
+    Path::new(
+        &std::env::var("CARGO_MANIFEST_DIR")
+            .unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned()),
+    )
+    .join("../../..")
 }
 
 /// An ASCII STL of an axis-aligned box (half extents in file units).

@@ -12,11 +12,13 @@ use spacepose_model::Target;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-const FIXTURE: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../core/cnn/fixtures/fixed_deos"
-);
-const DEOS_MODEL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../core/cnn/models/deos");
+/// A directory of the cnn crate, from the manifest directory cargo gives
+/// the test at run time.
+fn cnn_dir(sub: &str) -> String {
+    let root = std::env::var("CARGO_MANIFEST_DIR")
+        .unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned());
+    format!("{root}/../../core/cnn/{sub}")
+}
 
 fn config(model_dir: &str, methods: Vec<MethodKind>) -> InitServiceConfig {
     let mut config = InitServiceConfig {
@@ -43,7 +45,10 @@ fn a_missing_model_is_a_build_error_naming_the_directory() {
 
 #[test]
 fn the_cnn_comes_first_and_a_sparse_frame_is_a_failure() {
-    let config = config(FIXTURE, vec![MethodKind::Cnn, MethodKind::TemplateMatching]);
+    let config = config(
+        &cnn_dir("fixtures/fixed_deos"),
+        vec![MethodKind::Cnn, MethodKind::TemplateMatching],
+    );
     let chain = config.build_chain().unwrap();
     assert_eq!(
         chain.methods(),
@@ -57,12 +62,13 @@ fn the_cnn_comes_first_and_a_sparse_frame_is_a_failure() {
 
 #[test]
 fn held_out_frames_are_acquired_by_the_cnn() {
-    if !Path::new(DEOS_MODEL).join("model.onnx").is_file() {
-        println!("skipped: no trained model at {DEOS_MODEL}/model.onnx");
+    let deos_model = cnn_dir("models/deos");
+    if !Path::new(&deos_model).join("model.onnx").is_file() {
+        println!("skipped: no trained model at {deos_model}/model.onnx");
         return;
     }
     let config = config(
-        DEOS_MODEL,
+        &deos_model,
         vec![MethodKind::Cnn, MethodKind::TemplateMatching],
     );
     let chain = config.build_chain().unwrap();

@@ -35,7 +35,11 @@ fn health_until(sub: &Subscriber<Health>, what: &str, pred: impl Fn(&Health) -> 
 }
 
 fn repo_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../..")
+    Path::new(
+        &std::env::var("CARGO_MANIFEST_DIR")
+            .unwrap_or_else(|_| env!("CARGO_MANIFEST_DIR").to_owned()),
+    )
+    .join("../../..")
 }
 
 /// A config file: the CNN (the default, relative `model_dir` unless given)
