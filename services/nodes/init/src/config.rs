@@ -148,15 +148,12 @@ impl InitServiceConfig {
 }
 
 impl InitServiceConfig {
-    /// Why the configured CNN cannot serve `target`: no model in
-    /// `cnn.model_dir`, or a model trained for another target. `None` when
-    /// it can (a model that is there but broken is left to the loader, whose
-    /// error stops the service).
+    /// Why the configured CNN cannot serve `target`: its model was trained
+    /// for another target. `None` otherwise: a missing or broken model is
+    /// a configuration error the loader reports and the service stops on
+    /// (a mistyped `model_dir` must not turn into a silent fallback).
     pub fn cnn_unavailable(&self, target: &str) -> Option<String> {
         let dir = crate::cnn_method::resolve_model_dir(&self.cnn.model_dir);
-        if !dir.join(spacepose_cnn::model_meta::MODEL_JSON).is_file() {
-            return Some(format!("no model in {}", dir.display()));
-        }
         match spacepose_cnn::model_meta::ModelMeta::read(&dir) {
             Ok(meta) if meta.target != target => Some(format!(
                 "the model in {} was trained for {}",
@@ -337,7 +334,11 @@ mod tests {
             },
             ..both
         };
-        let why = missing.cnn_unavailable("envisat").expect("no model");
-        assert!(why.contains("/nonexistent/model"), "{why}");
+        assert_eq!(missing.cnn_unavailable("envisat"), None, "a config error");
+        let e = missing
+            .build_chain()
+            .err()
+            .expect("a missing model stops init");
+        assert!(e.to_string().contains("/nonexistent/model"), "{e}");
     }
 }
