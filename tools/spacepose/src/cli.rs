@@ -22,6 +22,9 @@ pub enum Command {
     Sim(spacepose_eval::sim::SimArgs),
     /// Generate the synthetic CNN training set (depth images, soft labels) as .npy files.
     Dataset(spacepose_eval::dataset::DatasetArgs),
+    /// Train a CNN for a target package into its cnn/ directory (datasets,
+    /// PyTorch training, export, check); needs tools/train/setup.sh.
+    Train(spacepose_eval::train::TrainArgs),
     /// Evaluate an estimator against ground truth.
     #[command(subcommand)]
     Eval(EvalCommand),
@@ -172,7 +175,7 @@ pub enum EvalCommand {
     /// CNN pose estimation + NDT refinement (seed 004 Tables III-IV) on held-out frames.
     Cnn(spacepose_eval::cnn::EvalCnnArgs),
     /// Template-matching acquisition (seed 002 §4): success rate, time, f_CONV.
-    Tm(spacepose_eval::tm::EvalTmArgs),
+    Tm(Box<spacepose_eval::tm::EvalTmArgs>),
     /// Regenerate (or --check) the results tables of the README and docs/
     /// from the committed runs under docs/results/.
     Tables(spacepose_eval::tables::TablesArgs),

@@ -277,6 +277,18 @@ pub struct TemplateMatchingConfig {
     /// 0.2 m separated successes from failures at 20-40 m, 0.3 m and more
     /// did not at 30 m, and none did at 50 m.
     pub f_conv_cap_m: f64,
+    /// Point budget of one acquisition (0 = every point, seed 002): a frame
+    /// with more finite points is thinned by the smallest stride `s` that
+    /// brings it within the budget (every `s²`-th point), and its templates
+    /// are cast with the sensor's rays thinned alike (see the matcher's
+    /// `density` module). Default 1,000: on Mid-40 frames (development
+    /// seed 11, 10 frames each of deos, envisat, the telescope, relay,
+    /// comsat and probe test meshes at 5-30 m) 1,700 was slower and no
+    /// more successful; every point took 0.6-17 s per attempt. Seed 002's
+    /// raster (1,681 rays) is thinned only when more than 1,000 rays hit
+    /// (a large target within about 10 m). Figures in
+    /// `docs/design/target-packages.md`.
+    pub max_sensed_points: usize,
     /// Fewer finite points than this is
     /// [`AcquisitionError::TooFewPoints`](crate::AcquisitionError::TooFewPoints).
     pub min_points: usize,
@@ -341,6 +353,7 @@ impl Default for TemplateMatchingConfig {
             robust_f_conv: false,
             f_conv_cap_m: 0.2,
             min_points: 20,
+            max_sensed_points: 1000,
             model_spacing_m: 0.03,
             stage_model_spacing_m: 0.1,
             far_lookup: Some(FarLookup::default()),

@@ -4,8 +4,8 @@
 use crate::config::TemplateMatchingConfig;
 use crate::error::AcquisitionError;
 use crate::grid::euler_grid;
-use crate::template::TemplateRenderer;
 use crate::visibility::SensedTree;
+use density::Density;
 use nalgebra::{Rotation3, Vector3};
 use spacepose_geometry::{Euler321, Point, Pose};
 use spacepose_lidar_sim::{LidarSimulator, SensorConfig};
@@ -15,6 +15,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 mod candidates;
+mod density;
 mod scoring;
 mod second_chance;
 mod stages;
@@ -30,11 +31,8 @@ pub struct TemplateMatcher {
     sensor: SensorConfig,
     config: TemplateMatchingConfig,
     grid: Vec<(Euler321, Rotation3<f64>)>,
-    renderer: TemplateRenderer,
-    coarse_renderer: Option<TemplateRenderer>,
-    /// Tolerance of the reverse check (rad): `unexplained_spacings` times
-    /// the sensor's ray spacing.
-    tolerance_rad: f64,
+    /// The template renderers of each density level, stride 1 first.
+    levels: Vec<Density>,
     icp_model: IcpModel,
     /// The coarser model of the wide ICP stages, if configured.
     stage_model: Option<IcpModel>,
@@ -59,12 +57,7 @@ impl TemplateMatcher {
             .into_iter()
             .map(|e| (e, e.to_rotation()))
             .collect();
-        let renderer = TemplateRenderer::new(target.clone(), &sensor, config.template_stride);
-        let coarse_renderer = config
-            .coarse_to_fine
-            .map(|c| TemplateRenderer::new(target.clone(), &sensor, c.stride));
-        let tolerance_rad = config.unexplained_spacings
-            * TemplateRenderer::new(target.clone(), &sensor, 1).ray_spacing_rad();
+        let levels = Density::levels(&target, &sensor, &config);
         let model = target.sample_surface(config.model_spacing_m, MODEL_SEED);
         let vote_reach_m = bounding_radius(&model);
         let with_far = |m: IcpModel| {
@@ -88,9 +81,7 @@ impl TemplateMatcher {
             sensor,
             config,
             grid,
-            renderer,
-            coarse_renderer,
-            tolerance_rad,
+            levels,
             icp_model,
             stage_model,
             vote_reach_m,
@@ -135,7 +126,7 @@ impl TemplateMatcher {
 
     /// Rays per full-resolution template.
     pub fn template_rays(&self) -> usize {
-        self.renderer.rays()
+        self.levels[0].renderer.rays()
     }
 
     /// Sets f_MAX (m²), e.g. after `spacepose calibrate fconv`.
@@ -158,15 +149,15 @@ impl TemplateMatcher {
     }
 
     /// The unexplained fraction of `t_sensor_target` (see
-    /// [`crate::visibility`]).
-    fn unexplained(&self, sensed: &SensedTree, t_sensor_target: &Pose) -> f64 {
+    /// [`crate::visibility`]) with the templates of `density`.
+    fn unexplained(&self, density: &Density, sensed: &SensedTree, t_sensor_target: &Pose) -> f64 {
         let mut template = Vec::new();
-        self.renderer.render_into(
+        density.renderer.render_into(
             &t_sensor_target.rotation,
             &t_sensor_target.translation,
             &mut template,
         );
-        sensed.unexplained_fraction(&template, self.tolerance_rad)
+        sensed.unexplained_fraction(&template, density.tolerance_rad)
     }
 }
 

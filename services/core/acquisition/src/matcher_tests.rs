@@ -145,9 +145,10 @@ fn single_thread_and_parallel_agree() {
             ..m.config.clone()
         },
         grid: m.grid.clone(),
-        renderer: m.renderer.clone(),
-        coarse_renderer: None,
-        tolerance_rad: m.tolerance_rad,
+        levels: vec![Density {
+            coarse: None,
+            ..m.levels[0].clone()
+        }],
         icp_model: IcpModel::new(&m.target.sample_surface(0.3, 1)).unwrap(),
         stage_model: None,
         vote_reach_m: m.vote_reach_m,
@@ -167,7 +168,9 @@ fn single_thread_and_parallel_agree() {
             d_bor(&p),
         )
     };
+    let density = single.levels[0].clone();
     let sensed = Sensed {
+        density: &density,
         correlator: &corr.0,
         centre: corr.1,
         d_bor: corr.2,
@@ -236,16 +239,16 @@ fn a_flipped_pose_leaves_template_points_unexplained() {
     let cloud = frame(truth, Effects::none(), 3);
     let positions: Vec<Vector3<f64>> = cloud.iter().map(Point::position).collect();
     let sensed = SensedTree::new(&positions);
-    let own = m.unexplained(&sensed, &truth);
+    let own = m.unexplained(&m.levels[0], &sensed, &truth);
     let flip = Rotation3::from_axis_angle(&Vector3::y_axis(), std::f64::consts::PI) * r;
-    let flipped = m.unexplained(&sensed, &Pose::new(flip, truth.translation));
+    let flipped = m.unexplained(&m.levels[0], &sensed, &Pose::new(flip, truth.translation));
     assert!(own < 0.02, "{own}");
     assert!(flipped > 0.3, "{flipped}");
     // 1° raster, 1.5 spacings.
     assert!(
-        (m.tolerance_rad.to_degrees() - 1.5).abs() < 0.1,
+        (m.levels[0].tolerance_rad.to_degrees() - 1.5).abs() < 0.1,
         "{}",
-        m.tolerance_rad
+        m.levels[0].tolerance_rad
     );
 }
 
@@ -263,9 +266,9 @@ fn recentring_undoes_the_field_of_view_clipping() {
     let positions: Vec<Vector3<f64>> = cloud.iter().map(Point::position).collect();
     let mut scratch = Vec::new();
     let centre = Centering::Mean.centre(&positions, &mut scratch).unwrap();
-    let template = m.renderer.render(&r, &centre);
+    let template = m.levels[0].renderer.render(&r, &centre);
     let aligned = centre + centre - Centering::Mean.centre(&template, &mut scratch).unwrap();
-    let recentred = m.recentre(&r, aligned, &centre, Centering::Mean);
+    let recentred = m.recentre(&m.levels[0], &r, aligned, &centre, Centering::Mean);
     let before = (aligned - truth.translation).norm();
     let after = (recentred - truth.translation).norm();
     assert!(before > 1.0, "alignment alone is {before} m off");
@@ -295,10 +298,16 @@ fn revote_recovers_a_slid_solution() {
         stages,
     )
     .unwrap();
-    let u = m.unexplained(&sensed, &rejected.t_sensor_target);
+    let u = m.unexplained(&m.levels[0], &sensed, &rejected.t_sensor_target);
     assert!(!m.acceptable(rejected.f_conv_m2, u), "{rejected:?} U {u}");
     let (again, u_again) = m
-        .revote(&rejected.t_sensor_target, &cloud, &positions, &sensed)
+        .revote(
+            &m.levels[0],
+            &rejected.t_sensor_target,
+            &cloud,
+            &positions,
+            &sensed,
+        )
         .unwrap();
     let err_m = (again.t_sensor_target.translation - truth.translation).norm();
     let err_deg = so3::distance(&again.t_sensor_target.rotation, &r).to_degrees();
@@ -324,7 +333,7 @@ fn second_chance_undoes_a_half_turn() {
     let sensed = SensedTree::new(&positions);
     let half_turn = Rotation3::from_axis_angle(&Vector3::x_axis(), PI);
     let flipped = Pose::new(r * half_turn, truth.translation);
-    let tries = m.second_chance(&flipped, &cloud, &positions, &sensed);
+    let tries = m.second_chance(&m.levels[0], &flipped, &cloud, &positions, &sensed);
     assert_eq!(tries.len(), 4);
     let best = tries
         .iter()
@@ -368,10 +377,16 @@ fn slide_search_recovers_an_end_on_slide() {
     .unwrap();
     let off = |p: &Pose| (p.translation - truth.translation).norm();
     assert!(off(&rejected.t_sensor_target) > 3.0, "{rejected:?}");
-    let u = m.unexplained(&sensed, &rejected.t_sensor_target);
+    let u = m.unexplained(&m.levels[0], &sensed, &rejected.t_sensor_target);
     assert!(!m.acceptable(rejected.f_conv_m2, u), "{rejected:?} U {u}");
     let (again, u_again) = m
-        .slide(&rejected.t_sensor_target, &cloud, &positions, &sensed)
+        .slide(
+            &m.levels[0],
+            &rejected.t_sensor_target,
+            &cloud,
+            &positions,
+            &sensed,
+        )
         .unwrap();
     let err_deg = so3::distance(&again.t_sensor_target.rotation, &r).to_degrees();
     assert!(

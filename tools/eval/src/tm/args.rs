@@ -114,6 +114,10 @@ pub struct TmOptions {
     /// ...then the best N templates at full resolution.
     #[arg(long, default_value_t = 30)]
     pub coarse_keep: usize,
+    /// Point budget of an acquisition: denser frames and their templates
+    /// are thinned alike (0 = every point). Default: the library's.
+    #[arg(long)]
+    pub max_points: Option<usize>,
     /// Sensor points in the correlation (0 = all). Default: the
     /// library's.
     #[arg(long)]
@@ -188,6 +192,7 @@ impl TmOptions {
                 keep: self.coarse_keep,
             }),
             max_correlation_points: self.max_corr_points.unwrap_or(d.max_correlation_points),
+            max_sensed_points: self.max_points.unwrap_or(d.max_sensed_points),
             robust_f_conv: self.robust_f_conv,
             f_conv_cap_m: self.f_conv_cap.unwrap_or(d.f_conv_cap_m),
             far_lookup: self.far_lookup()?,

@@ -1,6 +1,7 @@
 //! The candidates handed to ICP: the best distinct templates, re-centred,
 //! placed by the translation vote and optionally screened by a short ICP.
 
+use super::density::Density;
 use super::{TemplateMatcher, strided};
 use crate::correlation::Centering;
 use crate::refine::screen;
@@ -21,6 +22,7 @@ impl TemplateMatcher {
     /// check, see `screen_rerank`), from where it left them.
     pub(super) fn screened_candidates(
         &self,
+        density: &Density,
         ranked: &[(usize, f64, Vector3<f64>)],
         cloud: &[Point],
         (positions, centre): (&[Vector3<f64>], &Vector3<f64>),
@@ -39,8 +41,8 @@ impl TemplateMatcher {
             .into_iter()
             .map(|(k, origin)| {
                 let r = self.grid[k].1;
-                let origin = self.recentre(&r, origin, centre, centering);
-                (k, Pose::new(r, self.vote(&r, origin, positions)))
+                let origin = self.recentre(density, &r, origin, centre, centering);
+                (k, Pose::new(r, self.vote(density, &r, origin, positions)))
             })
             .collect();
         let unscreened = |t: Vec<(usize, Pose)>| {
@@ -68,7 +70,7 @@ impl TemplateMatcher {
         if c.screen_rerank > keep && c.unexplained_weight_m2 > 0.0 {
             screened.truncate(c.screen_rerank);
             for s in &mut screened {
-                s.0 += c.unexplained_weight_m2 * self.unexplained(sensed, &s.2);
+                s.0 += c.unexplained_weight_m2 * self.unexplained(density, sensed, &s.2);
             }
             screened.sort_by(|a, b| a.0.total_cmp(&b.0));
         }
@@ -87,6 +89,7 @@ impl TemplateMatcher {
     /// re-render clips like the sensor did.
     pub(super) fn recentre(
         &self,
+        density: &Density,
         r: &Rotation3<f64>,
         mut origin: Vector3<f64>,
         centre: &Vector3<f64>,
@@ -94,7 +97,7 @@ impl TemplateMatcher {
     ) -> Vector3<f64> {
         let (mut template, mut scratch) = (Vec::new(), Vec::new());
         for _ in 0..self.config.recentre_iterations {
-            self.renderer.render_into(r, &origin, &mut template);
+            density.renderer.render_into(r, &origin, &mut template);
             if template.len() < 3 {
                 break;
             }
@@ -112,6 +115,7 @@ impl TemplateMatcher {
     /// finds nothing).
     pub(super) fn vote(
         &self,
+        density: &Density,
         r: &Rotation3<f64>,
         origin: Vector3<f64>,
         positions: &[Vector3<f64>],
@@ -120,7 +124,7 @@ impl TemplateMatcher {
         if bin <= 0.0 {
             return origin;
         }
-        let template = self.renderer.render(r, &origin);
+        let template = density.renderer.render(r, &origin);
         let mut scratch = VoteScratch::default();
         let reach = self.vote_reach_m;
         vote_translation(

@@ -3,6 +3,7 @@
 //! Eq. (3) pre-check and the optional coarse-to-fine pass.
 
 use super::TemplateMatcher;
+use super::density::Density;
 use crate::config::Threads;
 use crate::correlation::{Correlator, d_bor, d_bor_passes};
 use crate::template::TemplateRenderer;
@@ -26,6 +27,8 @@ pub(super) type Ranked = (usize, f64, Vector3<f64>);
 
 /// Per-acquisition inputs shared by every template evaluation.
 pub(super) struct Sensed<'a> {
+    /// The density level of the frame (its template renderers).
+    pub(super) density: &'a Density,
     pub(super) correlator: &'a Correlator,
     pub(super) centre: Vector3<f64>,
     pub(super) d_bor: f64,
@@ -37,9 +40,10 @@ impl TemplateMatcher {
     pub(super) fn match_templates(&self, sensed: &Sensed) -> (Vec<Ranked>, usize, usize) {
         let all: Vec<(usize, Vector3<f64>)> =
             (0..self.grid.len()).map(|k| (k, sensed.centre)).collect();
-        let (first, fine) = match (&self.coarse_renderer, self.config.coarse_to_fine) {
+        let renderer = &sensed.density.renderer;
+        let (first, fine) = match (&sensed.density.coarse, self.config.coarse_to_fine) {
             (Some(coarse), Some(c)) => (coarse, Some(c.keep)),
-            _ => (&self.renderer, None),
+            _ => (renderer, None),
         };
         let scores = self.score(&all, first, sensed, self.config.fast);
         let mut generated = scores.len();
@@ -54,7 +58,7 @@ impl TemplateMatcher {
                 .take(keep)
                 .map(|r| (r.0, sensed.centre))
                 .collect();
-            let scores = self.score(&kept, &self.renderer, sensed, false);
+            let scores = self.score(&kept, renderer, sensed, false);
             generated += scores.len();
             let coarse_rest = ranked.split_off(keep.min(ranked.len()));
             ranked = rank(&scores);

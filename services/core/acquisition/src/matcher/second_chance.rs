@@ -2,6 +2,7 @@
 //! [`crate::TemplateMatchingConfig::revote`]): half-turn flips placed again
 //! by the translation vote, and the slide search along the principal axis.
 
+use super::density::Density;
 use super::{TemplateMatcher, strided};
 use crate::refine::{Refined, refine_with_stages, screen};
 use crate::slide_search::{SLIDE_STEP_M, principal_axis, slide_poses};
@@ -18,6 +19,7 @@ impl TemplateMatcher {
     /// [`TemplateMatchingConfig::revote`]: crate::TemplateMatchingConfig::revote
     pub(super) fn second_chance(
         &self,
+        density: &Density,
         rejected: &Pose,
         cloud: &[Point],
         positions: &[Vector3<f64>],
@@ -29,9 +31,9 @@ impl TemplateMatcher {
             .chain((0..flips).map(|a| rejected.rotation * half_turn(a)))
             .filter_map(|r| {
                 let pose = Pose::new(r, rejected.translation);
-                self.revote(&pose, cloud, positions, sensed)
+                self.revote(density, &pose, cloud, positions, sensed)
             })
-            .chain(self.slide(rejected, cloud, positions, sensed))
+            .chain(self.slide(density, rejected, cloud, positions, sensed))
             .collect()
     }
 
@@ -46,6 +48,7 @@ impl TemplateMatcher {
     /// [`TemplateMatchingConfig::slide_reach_m`]: crate::TemplateMatchingConfig::slide_reach_m
     pub(super) fn slide(
         &self,
+        density: &Density,
         rejected: &Pose,
         cloud: &[Point],
         positions: &[Vector3<f64>],
@@ -77,7 +80,7 @@ impl TemplateMatcher {
             &stages[stages.len().saturating_sub(1)..],
         )
         .ok()?;
-        let u = self.unexplained(sensed, &again.t_sensor_target);
+        let u = self.unexplained(density, sensed, &again.t_sensor_target);
         Some((again, u))
     }
 
@@ -87,6 +90,7 @@ impl TemplateMatcher {
     /// fails; else the result and its unexplained fraction.
     pub(super) fn revote(
         &self,
+        density: &Density,
         rejected: &Pose,
         cloud: &[Point],
         positions: &[Vector3<f64>],
@@ -96,7 +100,7 @@ impl TemplateMatcher {
             return None;
         }
         let r = rejected.rotation;
-        let origin = self.vote(&r, rejected.translation, positions);
+        let origin = self.vote(density, &r, rejected.translation, positions);
         let again = refine_with_stages(
             &self.icp_model,
             self.stage_model(),
@@ -106,7 +110,7 @@ impl TemplateMatcher {
             &self.config.icp_stages_m,
         )
         .ok()?;
-        let u = self.unexplained(sensed, &again.t_sensor_target);
+        let u = self.unexplained(density, sensed, &again.t_sensor_target);
         Some((again, u))
     }
 }

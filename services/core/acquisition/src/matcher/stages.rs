@@ -3,6 +3,7 @@
 //! ICP refinement of the candidates with the second chance, and the
 //! outcome with the f_CONV check (§4.5).
 
+use super::density::stride_for;
 use super::scoring::{Ranked, Sensed};
 use super::{TemplateMatcher, ms_since};
 use crate::correlation::{Centering, Correlator, d_bor};
@@ -24,6 +25,8 @@ pub(super) struct Frame {
     centering: Centering,
     /// The position estimate of seed 002 §2.1: the (trimmed) centroid.
     centre: Vector3<f64>,
+    /// Index of the density level the frame was thinned to.
+    pub(super) density: usize,
 }
 
 /// The template-matching result of one frame.
@@ -182,17 +185,23 @@ impl TemplateMatcher {
         Ok(self.outcome(&frame, &matched, &refinements, timing))
     }
 
-    /// The finite points of `cloud`, their positions and centre.
+    /// The finite points of `cloud`, thinned to the point budget (see
+    /// [`super::density`]), their positions and centre.
     /// [`AcquisitionError::TooFewPoints`] with fewer than `min_points`
     /// finite points, or when the centre cannot be taken (`valid: 0`).
     pub(super) fn prepare(&self, cloud: &[Point]) -> Result<Frame, AcquisitionError> {
-        let finite: Vec<Point> = cloud.iter().copied().filter(Point::is_finite).collect();
+        let mut finite: Vec<Point> = cloud.iter().copied().filter(Point::is_finite).collect();
         if finite.len() < self.config.min_points {
             return Err(AcquisitionError::TooFewPoints {
                 valid: finite.len(),
                 total: cloud.len(),
                 required: self.config.min_points,
             });
+        }
+        let budget = self.config.max_sensed_points;
+        let stride = stride_for(finite.len(), budget, self.levels.len());
+        if stride > 1 {
+            finite = finite.into_iter().step_by(stride * stride).collect();
         }
         let positions: Vec<Vector3<f64>> = finite.iter().map(Point::position).collect();
         let centering = self.centering();
@@ -210,6 +219,7 @@ impl TemplateMatcher {
             positions,
             centering,
             centre,
+            density: stride - 1,
         })
     }
 
@@ -235,6 +245,7 @@ impl TemplateMatcher {
             self.config.symmetric_correlation,
         );
         let sensed = Sensed {
+            density: &self.levels[frame.density],
             correlator: &correlator,
             centre: frame.centre,
             d_bor: d_bor(&frame.positions),
@@ -243,7 +254,7 @@ impl TemplateMatcher {
         // Correlations computed at full resolution (the fine pass only,
         // with coarse-to-fine).
         let evaluated = match self.config.coarse_to_fine {
-            Some(c) if self.coarse_renderer.is_some() => ranked.len().min(c.keep),
+            Some(c) if self.levels[frame.density].coarse.is_some() => ranked.len().min(c.keep),
             _ => ranked.len(),
         };
         let Some(&(_, best_c, _)) = ranked.first() else {
@@ -270,7 +281,9 @@ impl TemplateMatcher {
         frame: &Frame,
         sensed_tree: &SensedTree,
     ) -> Refinements {
+        let density = &self.levels[frame.density];
         let (candidates, starts, screened) = self.screened_candidates(
+            density,
             ranked,
             &frame.finite,
             (&frame.positions, &frame.centre),
@@ -301,7 +314,7 @@ impl TemplateMatcher {
         let unexplained: Vec<f64> = refined
             .iter()
             .map(|r| match r {
-                Ok(r) => self.unexplained(sensed_tree, &r.t_sensor_target),
+                Ok(r) => self.unexplained(density, sensed_tree, &r.t_sensor_target),
                 Err(_) => 1.0,
             })
             .collect();
@@ -331,6 +344,7 @@ impl TemplateMatcher {
             && !self.acceptable(r.msd_all_m2, u)
         {
             for (again, u_again) in self.second_chance(
+                &self.levels[frame.density],
                 &r.t_sensor_target,
                 &frame.finite,
                 &frame.positions,
