@@ -22,4 +22,5 @@ pub mod tables;
 pub mod target;
 pub mod tm;
 pub mod tracking;
+pub mod train;
 pub mod truth_csv;

@@ -32,7 +32,9 @@ pub struct CnnMethodConfig {
     /// Directory holding `model.onnx` and `model.json`. A relative path is
     /// looked up in the service's working directory, then in the source
     /// tree's root (where `services/core/cnn/models/<target>` is committed).
-    pub model_dir: PathBuf,
+    /// Absent (the default): the target's own model, see
+    /// [`crate::config::InitServiceConfig::cnn_model_dir`].
+    pub model_dir: Option<PathBuf>,
     /// The inference engine.
     pub engine: CnnEngine,
     /// ONNX Runtime library for `engine = "ort"`; absent: `$ORT_DYLIB_PATH`
@@ -49,7 +51,7 @@ impl Default for CnnMethodConfig {
     fn default() -> Self {
         let estimator = EstimatorConfig::default();
         Self {
-            model_dir: PathBuf::from("services/core/cnn/models/deos"),
+            model_dir: None,
             engine: CnnEngine::Tract,
             ort_library: None,
             f_max_m2: estimator.refinement.f_max_m2,
@@ -117,14 +119,17 @@ pub struct CnnMethod {
 }
 
 impl CnnMethod {
-    /// Loads the model (checked against the class table) and builds the
-    /// NDT map for `target`.
-    pub fn new(target: Arc<Target>, config: &CnnMethodConfig) -> Result<Self, InitError> {
+    /// Loads the model in `model_dir` (checked against the class table)
+    /// and builds the NDT map for `target`.
+    pub fn new(
+        target: Arc<Target>,
+        model_dir: &Path,
+        config: &CnnMethodConfig,
+    ) -> Result<Self, InitError> {
         config.validate()?;
         let mut estimator = config.estimator.clone();
         estimator.refinement.f_max_m2 = config.f_max_m2;
-        let model_dir = resolve_model_dir(&config.model_dir);
-        let estimator = CnnEstimator::load_with(&model_dir, config.engine()?, target, estimator)
+        let estimator = CnnEstimator::load_with(model_dir, config.engine()?, target, estimator)
             .map_err(|e| build_error(e.to_string()))?;
         Ok(Self { estimator })
     }

@@ -2,16 +2,19 @@
 //! `deploy/examples/init.toml`), and the method chain it describes.
 
 use crate::chain::MethodChain;
-use crate::cnn_method::{CnnMethod, CnnMethodConfig};
+use crate::cnn_method::{CnnMethod, CnnMethodConfig, resolve_model_dir};
 use crate::error::InitError;
 use crate::method::PoseAcquirer;
 use crate::state::InitConfig;
 use crate::template::TemplateMatching;
 use serde::{Deserialize, Serialize};
 use spacepose_acquisition::TemplateMatchingConfig;
+use spacepose_cnn::model_meta::ModelMeta;
 use spacepose_lidar_sim::SensorConfig;
 use spacepose_messages::Name;
+use spacepose_model::package::TargetPackage;
 use spacepose_runtime::ServiceConfig;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// An acquisition method the service can run.
@@ -120,10 +123,9 @@ impl InitServiceConfig {
 
     /// Resolves the target and builds every configured method, in order.
     pub fn build_chain(&self) -> Result<MethodChain, InitError> {
-        let target = spacepose_prepare::resolve(&self.target, self.target_scale)
-            .map_err(|e| InitError::InvalidConfig(format!("target {:?}: {e}", self.target)))?
-            .target;
-        let target = Arc::new(target);
+        let package = spacepose_prepare::resolve(&self.target, self.target_scale)
+            .map_err(|e| InitError::InvalidConfig(format!("target {:?}: {e}", self.target)))?;
+        let target = Arc::new(package.target.clone());
         let mut methods: Vec<Box<dyn PoseAcquirer>> = Vec::new();
         for kind in &self.methods {
             match kind {
@@ -132,14 +134,23 @@ impl InitServiceConfig {
                     self.sensor(),
                     self.template_matching.clone(),
                 )?)),
-                MethodKind::Cnn => match self.cnn_unavailable(target.name()) {
-                    Some(why) if self.methods.contains(&MethodKind::TemplateMatching) => {
+                MethodKind::Cnn => match self.cnn_model_dir(&package) {
+                    Ok(dir) => {
+                        tracing::info!(target = target.name(), "CNN model from {}", dir.display());
+                        methods.push(Box::new(CnnMethod::new(target.clone(), &dir, &self.cnn)?));
+                    }
+                    Err(why) if self.methods.contains(&MethodKind::TemplateMatching) => {
                         tracing::warn!(
                             target = target.name(),
                             "no CNN for this target ({why}): acquiring by template matching alone"
                         );
                     }
-                    _ => methods.push(Box::new(CnnMethod::new(target.clone(), &self.cnn)?)),
+                    Err(why) => {
+                        return Err(InitError::InvalidConfig(format!(
+                            "no CNN for target {} ({why}) and template matching is not configured",
+                            target.name()
+                        )));
+                    }
                 },
             }
         }
@@ -148,19 +159,42 @@ impl InitServiceConfig {
 }
 
 impl InitServiceConfig {
-    /// Why the configured CNN cannot serve `target`: its model was trained
-    /// for another target. `None` otherwise: a missing or broken model is
-    /// a configuration error the loader reports and the service stops on
-    /// (a mistyped `model_dir` must not turn into a silent fallback).
-    pub fn cnn_unavailable(&self, target: &str) -> Option<String> {
-        let dir = crate::cnn_method::resolve_model_dir(&self.cnn.model_dir);
-        match spacepose_cnn::model_meta::ModelMeta::read(&dir) {
-            Ok(meta) if meta.target != target => Some(format!(
+    /// The CNN model directory for `package`:
+    /// - `cnn.model_dir` when configured; a missing or broken directory is
+    ///   returned as it is, for the loader to report as a configuration
+    ///   error (a mistyped path must not turn into a silent fallback);
+    /// - else the package's own model (`DIR/cnn`, written by
+    ///   `spacepose train --target DIR`);
+    /// - else, for a built-in target, its model committed in the source
+    ///   tree (`services/core/cnn/models/<name>`).
+    ///
+    /// `Err(why)` when there is no model for this target, or the model
+    /// found was trained for another one: template matching then acquires
+    /// alone, if configured.
+    pub fn cnn_model_dir(&self, package: &TargetPackage) -> Result<PathBuf, String> {
+        let name = package.target.name();
+        let dir = match &self.cnn.model_dir {
+            Some(dir) => resolve_model_dir(dir),
+            None => package
+                .cnn_dir()
+                .or_else(|| {
+                    let committed = Path::new("services/core/cnn/models").join(name);
+                    let dir = resolve_model_dir(&committed);
+                    dir.join("model.json").is_file().then_some(dir)
+                })
+                .ok_or_else(|| {
+                    "the package has no model; `spacepose train --target DIR` trains one into \
+                     a package directory"
+                        .to_string()
+                })?,
+        };
+        match ModelMeta::read(&dir) {
+            Ok(meta) if meta.target != name => Err(format!(
                 "the model in {} was trained for {}",
                 dir.display(),
                 meta.target
             )),
-            _ => None,
+            _ => Ok(dir),
         }
     }
 }
@@ -177,168 +211,5 @@ impl ServiceConfig for InitServiceConfig {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn defaults_are_valid_and_round_trip_through_toml() {
-        let c = InitServiceConfig::default();
-        c.validate().unwrap();
-        let text = toml::to_string(&c).unwrap();
-        let back: InitServiceConfig = toml::from_str(&text).unwrap();
-        assert_eq!(back, c);
-    }
-
-    /// `deploy/examples/init.toml` parses, and so does its commented
-    /// `[template_matching]` example once uncommented.
-    #[test]
-    fn the_deploy_example_parses() {
-        let text = include_str!(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../../deploy/examples/init.toml"
-        ));
-        let c: InitServiceConfig = toml::from_str(text).unwrap();
-        c.validate().unwrap();
-        let uncommented: String = text
-            .lines()
-            .map(|l| match l.strip_prefix("# ") {
-                Some(rest) if rest.starts_with("[template_matching") || rest.contains(" = ") => {
-                    rest.split('#').next().unwrap_or("").trim_end()
-                }
-                _ => l,
-            })
-            .collect::<Vec<_>>()
-            .join("\n");
-        let c: InitServiceConfig = toml::from_str(&uncommented).unwrap();
-        c.validate().unwrap();
-        assert_eq!(c.template_matching.u_max, 0.3);
-        assert_eq!(c.template_matching.icp.max_iterations, 40);
-        assert_eq!(
-            c.template_matching.far_lookup,
-            TemplateMatchingConfig::default().far_lookup
-        );
-    }
-
-    /// The file's `instance` is the instance name unless `--instance` is
-    /// given; the trait's validation is the config's.
-    #[test]
-    fn the_instance_key_names_the_instance() {
-        let c: InitServiceConfig = toml::from_str("instance = \"init-b\"\n").unwrap();
-        assert_eq!(ServiceConfig::instance(&c), Some("init-b"));
-        assert_eq!(ServiceConfig::instance(&InitServiceConfig::default()), None);
-        let bad: InitServiceConfig = toml::from_str("instance = \"bad name!\"\n").unwrap();
-        let e = ServiceConfig::validate(&bad).unwrap_err();
-        assert!(e.contains("instance"), "{e}");
-        assert!(ServiceConfig::validate(&c).is_ok());
-    }
-
-    #[test]
-    fn partial_files_take_defaults_and_unknown_keys_fail() {
-        let c: InitServiceConfig =
-            toml::from_str("target = \"deos\"\n[state]\nretry_after_frames = 2\n").unwrap();
-        assert_eq!(c.state.retry_after_frames, 2);
-        assert_eq!(
-            c.state.handover_frames,
-            InitConfig::default().handover_frames
-        );
-        assert!(toml::from_str::<InitServiceConfig>("targett = \"deos\"").is_err());
-        assert!(toml::from_str::<InitServiceConfig>("[state]\nretry = 1").is_err());
-        // The matcher's and its ICP's sections are partial too.
-        let c: InitServiceConfig = toml::from_str(
-            "[template_matching]\nu_max = 0.4\n[template_matching.icp]\nmax_iterations = 30\n",
-        )
-        .unwrap();
-        assert_eq!(c.template_matching.u_max, 0.4);
-        assert_eq!(c.template_matching.icp.max_iterations, 30);
-        assert_eq!(
-            c.template_matching.delta_deg,
-            TemplateMatchingConfig::default().delta_deg
-        );
-        assert!(toml::from_str::<InitServiceConfig>("[template_matching]\numax = 0.4").is_err());
-    }
-
-    #[test]
-    fn nan_zero_and_unavailable_values_fail_validation() {
-        let base = InitServiceConfig::default();
-        let mut tm_nan = base.template_matching.clone();
-        tm_nan.f_max_m2 = f64::NAN;
-        for c in [
-            InitServiceConfig {
-                target_scale: f64::NAN,
-                ..base.clone()
-            },
-            InitServiceConfig {
-                integration_time_s: f64::NAN,
-                ..base.clone()
-            },
-            InitServiceConfig {
-                integration_time_s: 0.0,
-                ..base.clone()
-            },
-            InitServiceConfig {
-                methods: vec![],
-                ..base.clone()
-            },
-            InitServiceConfig {
-                methods: vec![MethodKind::Cnn, MethodKind::TemplateMatching],
-                cnn: CnnMethodConfig {
-                    f_max_m2: f64::NAN,
-                    ..CnnMethodConfig::default()
-                },
-                ..base.clone()
-            },
-            InitServiceConfig {
-                min_points: 2,
-                ..base.clone()
-            },
-            InitServiceConfig {
-                instance: Some("bad name!".into()),
-                ..base.clone()
-            },
-            InitServiceConfig {
-                template_matching: tm_nan,
-                ..base.clone()
-            },
-        ] {
-            assert!(c.validate().is_err(), "{c:?}");
-        }
-    }
-
-    #[test]
-    fn a_target_without_a_cnn_acquires_by_template_matching_alone() {
-        let both = InitServiceConfig {
-            target: "envisat".into(),
-            methods: vec![MethodKind::Cnn, MethodKind::TemplateMatching],
-            ..InitServiceConfig::default()
-        };
-        let why = both
-            .cnn_unavailable("envisat")
-            .expect("the model is deos's");
-        assert!(why.contains("trained for deos"), "{why}");
-        assert_eq!(both.cnn_unavailable("deos"), None);
-        let chain = both.build_chain().expect("template matching alone");
-        let tm = spacepose_messages::AcquisitionMethod::TemplateMatching;
-        assert_eq!(chain.methods(), vec![tm]);
-
-        let cnn_only = InitServiceConfig {
-            methods: vec![MethodKind::Cnn],
-            ..both.clone()
-        };
-        let e = cnn_only.build_chain().err().expect("no method left");
-        assert!(e.to_string().contains("deos"), "{e}");
-
-        let missing = InitServiceConfig {
-            cnn: CnnMethodConfig {
-                model_dir: "/nonexistent/model".into(),
-                ..CnnMethodConfig::default()
-            },
-            ..both
-        };
-        assert_eq!(missing.cnn_unavailable("envisat"), None, "a config error");
-        let e = missing
-            .build_chain()
-            .err()
-            .expect("a missing model stops init");
-        assert!(e.to_string().contains("/nonexistent/model"), "{e}");
-    }
-}
+#[path = "config_tests.rs"]
+mod tests;

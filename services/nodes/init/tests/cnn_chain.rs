@@ -25,7 +25,7 @@ fn config(model_dir: &str, methods: Vec<MethodKind>) -> InitServiceConfig {
         methods,
         ..InitServiceConfig::default()
     };
-    config.cnn.model_dir = PathBuf::from(model_dir);
+    config.cnn.model_dir = Some(PathBuf::from(model_dir));
     config.validate().unwrap();
     config
 }

@@ -30,6 +30,19 @@ pub use manifest::{
 use crate::target::Target;
 use std::path::PathBuf;
 
+/// The package's subdirectory for its CNN (`model.onnx`, `model.json`),
+/// written by `spacepose train --target DIR`.
+pub const CNN_DIR: &str = "cnn";
+
+impl TargetPackage {
+    /// The package's CNN directory when it holds a model (`None` for an
+    /// embedded built-in or a package without one).
+    pub fn cnn_dir(&self) -> Option<PathBuf> {
+        let dir = self.dir.as_ref()?.join(CNN_DIR);
+        dir.join("model.onnx").is_file().then_some(dir)
+    }
+}
+
 /// A loaded target package: the target and its manifest.
 #[derive(Clone, Debug)]
 pub struct TargetPackage {
