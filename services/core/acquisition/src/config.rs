@@ -251,6 +251,18 @@ pub struct TemplateMatchingConfig {
     /// fraction is 0.03-0.2 at the 90th percentile (the solar array at
     /// grazing incidence drops below the detection threshold).
     pub u_max: f64,
+    /// The twin check (see the matcher's `twins` module; 0 = off): the
+    /// solution is not accepted when a refinement of another hypothesis,
+    /// e.g. a near-symmetric twin of the target, scores within this factor
+    /// of it by `f_CONV + w · U`. A ratio, so the same for every target.
+    /// Default 1.1, chosen on development seed 11 (Mid-40, 10 frames a
+    /// row; `docs/design/target-packages.md`): false accepts on the deos,
+    /// envisat 10 m, telescope 10 m and relay rows went 20 (off) → 8 (1.1),
+    /// 5 (1.25), 3 (1.5), while accepted and correct went on deos
+    /// 60-80 % → 20-30 % (1.1) → 0-10 % (1.5) and on the relay satellite
+    /// 50-80 % → 50-60 % → 0 %: a rejected frame costs one more attempt,
+    /// a false accept a track of the wrong pose.
+    pub twin_ambiguity: f64,
     /// Iterations of each screening stage.
     pub screen_iterations: usize,
     /// Minimum angle (deg) between two refined candidates: a template
@@ -346,6 +358,7 @@ impl Default for TemplateMatchingConfig {
             // Tuning seed 3 (see `TemplateMatchingConfig::u_max`).
             unexplained_weight_m2: 0.05,
             u_max: 0.3,
+            twin_ambiguity: 1.1,
             screen_iterations: 10,
             candidate_separation_deg: 45.0,
             // Off: on 3 × 30 frames the cap did not separate better (see

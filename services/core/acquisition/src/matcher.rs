@@ -16,9 +16,11 @@ use std::time::Instant;
 
 mod candidates;
 mod density;
+mod refinements;
 mod scoring;
 mod second_chance;
 mod stages;
+mod twins;
 
 /// Seed of the model-cloud sampling (any fixed value: the cloud is deterministic).
 const MODEL_SEED: u64 = 0x5eed_0002;

@@ -28,8 +28,8 @@ pub struct AcquisitionOutcome {
     /// rendered at the refined pose that no sensed point explains (see
     /// [`crate::visibility`]); 1 when every refinement failed.
     pub unexplained_fraction: f64,
-    /// `f_conv_m2 <= f_max_m2` and `unexplained_fraction <= u_max`: the
-    /// solution can initialise tracking.
+    /// `f_conv_m2 <= f_max_m2`, `unexplained_fraction <= u_max` and no
+    /// twin ambiguity: the solution can initialise tracking.
     pub accepted: bool,
     /// Templates rendered (both passes of coarse-to-fine count).
     pub templates_generated: usize,
@@ -61,4 +61,7 @@ pub struct AcquisitionOutcome {
     pub icp_inlier_fraction: f64,
     /// Why refinement failed for the winning candidate, if it did.
     pub refinement_error: Option<String>,
+    /// A near-symmetric twin of the solution fits the frame about as well
+    /// (see the matcher's twin check): the solution is not accepted.
+    pub twin_ambiguous: bool,
 }

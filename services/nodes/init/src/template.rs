@@ -46,8 +46,19 @@ impl PoseAcquirer for TemplateMatching {
             f_conv_m2: o.f_conv_m2,
             accepted: o.accepted,
             detail: format!(
-                "{} templates evaluated, matching {:.0} ms, ICP {:.0} ms ({} iterations)",
-                o.templates_evaluated, o.matching_ms, o.refinement_ms, o.icp_iterations
+                "{} points, {} templates evaluated, matching {:.0} ms, ICP {:.0} ms ({} \
+                 iterations), unexplained {:.2}{}",
+                o.points_used,
+                o.templates_evaluated,
+                o.matching_ms,
+                o.refinement_ms,
+                o.icp_iterations,
+                o.unexplained_fraction,
+                if o.twin_ambiguous {
+                    ", rejected: another hypothesis (a twin) fits as well"
+                } else {
+                    ""
+                }
             ),
         })
     }

@@ -114,6 +114,11 @@ pub struct TmOptions {
     /// ...then the best N templates at full resolution.
     #[arg(long, default_value_t = 30)]
     pub coarse_keep: usize,
+    /// Reject a solution when another hypothesis (e.g. a near-symmetric
+    /// twin) scores within this factor of it (0 = off). Default: the
+    /// library's.
+    #[arg(long)]
+    pub twin_ambiguity: Option<f64>,
     /// Point budget of an acquisition: denser frames and their templates
     /// are thinned alike (0 = every point). Default: the library's.
     #[arg(long)]
@@ -193,6 +198,7 @@ impl TmOptions {
             }),
             max_correlation_points: self.max_corr_points.unwrap_or(d.max_correlation_points),
             max_sensed_points: self.max_points.unwrap_or(d.max_sensed_points),
+            twin_ambiguity: self.twin_ambiguity.unwrap_or(d.twin_ambiguity),
             robust_f_conv: self.robust_f_conv,
             f_conv_cap_m: self.f_conv_cap.unwrap_or(d.f_conv_cap_m),
             far_lookup: self.far_lookup()?,

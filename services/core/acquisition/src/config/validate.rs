@@ -67,6 +67,15 @@ impl TemplateMatchingConfig {
                 "must be finite and >= 0",
             ));
         }
+        if !(self.twin_ambiguity == 0.0 || self.twin_ambiguity >= 1.0)
+            || !self.twin_ambiguity.is_finite()
+        {
+            return Err(bad(
+                "twin_ambiguity",
+                self.twin_ambiguity,
+                "must be 0 (off) or a finite factor >= 1",
+            ));
+        }
         if !(self.u_max >= 0.0 && self.u_max <= 1.0) {
             return Err(bad("u_max", self.u_max, "must be in [0, 1]"));
         }

@@ -4,6 +4,7 @@
 //! outcome with the f_CONV check (§4.5).
 
 use super::density::stride_for;
+use super::refinements::Refinements;
 use super::scoring::{Ranked, Sensed};
 use super::{TemplateMatcher, ms_since};
 use crate::correlation::{Centering, Correlator, d_bor};
@@ -12,7 +13,7 @@ use crate::outcome::AcquisitionOutcome;
 use crate::refine::{Refined, refine_with_stages};
 use crate::visibility::SensedTree;
 use nalgebra::Vector3;
-use spacepose_geometry::{Point, Pose};
+use spacepose_geometry::Point;
 use std::time::Instant;
 
 /// One frame's finite points and the centre they are matched at.
@@ -43,40 +44,6 @@ pub(super) struct Matched {
     best_c: f64,
 }
 
-/// The ICP refinements of one frame's candidates; `candidates`, `refined`
-/// and `unexplained` are index-aligned (index = rank).
-pub(super) struct Refinements {
-    /// `(grid index, template pose)` of each refinement.
-    candidates: Vec<(usize, Pose)>,
-    /// The refinement results (errors as their messages).
-    refined: Vec<Result<Refined, String>>,
-    /// Unexplained fraction of each result (1 for a failed refinement).
-    unexplained: Vec<f64>,
-    /// Candidates screened by a short ICP (0 when screening is off).
-    screened: usize,
-}
-
-/// The chosen solution: the winning refinement, or the first candidate's
-/// template pose when every refinement failed.
-struct Chosen {
-    /// Index of the winning candidate in [`Refinements`].
-    rank: usize,
-    /// The refined pose (the template pose if every refinement failed).
-    pose: Pose,
-    /// f_CONV (m²), infinite if every refinement failed.
-    f_conv_m2: f64,
-    /// ICP iterations over all stages.
-    iterations: usize,
-    /// The final ICP stage converged.
-    converged: bool,
-    /// Inlier fraction of the final ICP stage.
-    inlier_fraction: f64,
-    /// Unexplained fraction, 1 if every refinement failed.
-    unexplained_fraction: f64,
-    /// The first candidate's refinement error if every refinement failed.
-    refinement_error: Option<String>,
-}
-
 /// Wall times of one acquisition.
 #[derive(Clone, Copy)]
 pub(super) struct Timing {
@@ -95,64 +62,6 @@ impl Matched {
             .iter()
             .find(|r| r.0 == k)
             .map_or(self.best_c, |r| r.1)
-    }
-}
-
-impl Refinements {
-    /// The successful refinement with the lowest uncapped f_CONV plus `w`
-    /// times its unexplained fraction: `(index, result, unexplained)`.
-    fn first_best(&self, w: f64) -> Option<(usize, &Refined, f64)> {
-        self.refined
-            .iter()
-            .zip(&self.unexplained)
-            .enumerate()
-            .filter_map(|(i, (r, &u))| r.as_ref().ok().map(|r| (i, r, u)))
-            .min_by(|a, b| (a.1.msd_all_m2 + w * a.2).total_cmp(&(b.1.msd_all_m2 + w * b.2)))
-    }
-
-    /// The successful refinement with the lowest uncapped f_CONV, plus `w`
-    /// times its unexplained fraction when `w > 0`: `(index, result)`.
-    fn best(&self, w: f64) -> Option<(usize, &Refined)> {
-        let score = |i: usize, r: &Refined| {
-            if w > 0.0 {
-                r.msd_all_m2 + w * self.unexplained[i]
-            } else {
-                r.msd_all_m2
-            }
-        };
-        self.refined
-            .iter()
-            .enumerate()
-            .filter_map(|(i, r)| r.as_ref().ok().map(|r| (i, r)))
-            .min_by(|a, b| score(a.0, a.1).total_cmp(&score(b.0, b.1)))
-    }
-
-    /// The chosen solution (see [`Refinements::best`], weight `w`); when
-    /// every refinement failed, the first candidate's template pose with
-    /// f_CONV infinite, unexplained fraction 1 and the first error.
-    fn choose(&self, w: f64) -> Chosen {
-        match self.best(w) {
-            Some((i, r)) => Chosen {
-                rank: i,
-                pose: r.t_sensor_target,
-                f_conv_m2: r.f_conv_m2,
-                iterations: r.iterations,
-                converged: r.converged,
-                inlier_fraction: r.inlier_fraction,
-                unexplained_fraction: self.unexplained[i],
-                refinement_error: None,
-            },
-            None => Chosen {
-                rank: 0,
-                pose: self.candidates[0].1,
-                f_conv_m2: f64::INFINITY,
-                iterations: 0,
-                converged: false,
-                inlier_fraction: 0.0,
-                unexplained_fraction: 1.0,
-                refinement_error: self.refined.first().and_then(|r| r.as_ref().err().cloned()),
-            },
-        }
     }
 }
 
@@ -177,12 +86,17 @@ impl TemplateMatcher {
         let sensed_tree = SensedTree::new(&frame.positions);
         let mut refinements = self.refine_candidates(&matched.ranked, &frame, &sensed_tree);
         self.add_second_chance(&mut refinements, &frame, &sensed_tree);
+        let density = &self.levels[frame.density];
+        let ambiguous = self.add_twins(density, &mut refinements, &frame, &sensed_tree);
         let timing = Timing {
             start,
             matching_ms,
             refinement_ms: ms_since(refine_start),
         };
-        Ok(self.outcome(&frame, &matched, &refinements, timing))
+        let mut outcome = self.outcome(&frame, &matched, &refinements, timing);
+        outcome.twin_ambiguous = ambiguous;
+        outcome.accepted &= !ambiguous;
+        Ok(outcome)
     }
 
     /// The finite points of `cloud`, thinned to the point budget (see
@@ -350,9 +264,7 @@ impl TemplateMatcher {
                 &frame.positions,
                 sensed_tree,
             ) {
-                refinements.refined.push(Ok(again));
-                refinements.unexplained.push(u_again);
-                refinements.candidates.push(refinements.candidates[i]);
+                refinements.push(i, Ok(again), u_again);
             }
         }
     }
@@ -393,6 +305,7 @@ impl TemplateMatcher {
             icp_converged: chosen.converged,
             icp_inlier_fraction: chosen.inlier_fraction,
             refinement_error: chosen.refinement_error,
+            twin_ambiguous: false,
         }
     }
 }
