@@ -85,17 +85,21 @@ fn demo_descriptor(opts: &DemoOptions) -> Result<Descriptor> {
 }
 
 /// The symmetry group of the sensor's target, for scoring with `d_sym`:
-/// a built-in target's declared group; none for a mesh file (which declares
-/// none) or an unknown name (lidar-sim's own `--check` reports that).
+/// the group its package records (built-in, package directory or mesh
+/// file, resolved as lidar-sim resolves it); none when the target cannot
+/// be resolved (lidar-sim's own `--check` reports that).
 fn target_symmetries(d: &Descriptor) -> Vec<nalgebra::Rotation3<f64>> {
-    let name = d
+    let config = d
         .instances_of(ServiceKind::LidarSim)
         .next()
-        .and_then(|s| s.config.get("target"))
+        .map(|s| &s.config);
+    let get = |key: &str| config.and_then(|c| c.get(key));
+    let name = get("target")
         .and_then(toml::Value::as_str)
         .unwrap_or("deos");
-    spacepose_model::Target::builtin(name)
-        .map(|t| t.symmetries().to_vec())
+    let scale = get("scale").and_then(toml::Value::as_float).unwrap_or(1.0);
+    spacepose_prepare::resolve(name, scale)
+        .map(|p| p.target.symmetries().to_vec())
         .unwrap_or_default()
 }
 
