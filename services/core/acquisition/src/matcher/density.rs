@@ -42,9 +42,16 @@ impl Density {
         stride: usize,
     ) -> Self {
         let fine = config.template_stride * stride;
-        let spacing = TemplateRenderer::new(target.clone(), sensor, stride).ray_spacing_rad();
+        let renderer = TemplateRenderer::new(target.clone(), sensor, fine);
+        // The reverse check compares with the sensor's sampling at this
+        // level, whatever thinning the templates add on top of it.
+        let spacing = if fine == stride {
+            renderer.ray_spacing_rad()
+        } else {
+            TemplateRenderer::new(target.clone(), sensor, stride).ray_spacing_rad()
+        };
         Self {
-            renderer: TemplateRenderer::new(target.clone(), sensor, fine),
+            renderer,
             coarse: config
                 .coarse_to_fine
                 .map(|c| TemplateRenderer::new(target.clone(), sensor, c.stride * fine)),

@@ -15,6 +15,9 @@ pub(super) struct Refinements {
     pub(super) unexplained: Vec<f64>,
     /// Candidates screened by a short ICP (0 when screening is off).
     pub(super) screened: usize,
+    /// Another hypothesis fits about as well as the best (see the
+    /// matcher's `twins` module): the solution is not accepted.
+    pub(super) ambiguous: bool,
 }
 
 /// The chosen solution: the winning refinement, or the first candidate's
@@ -39,32 +42,17 @@ pub(super) struct Chosen {
 }
 
 impl Refinements {
-    /// The successful refinement with the lowest uncapped f_CONV plus `w`
-    /// times its unexplained fraction: `(index, result, unexplained)`.
-    pub(super) fn first_best(&self, w: f64) -> Option<(usize, &Refined, f64)> {
-        self.refined
-            .iter()
-            .zip(&self.unexplained)
-            .enumerate()
-            .filter_map(|(i, (r, &u))| r.as_ref().ok().map(|r| (i, r, u)))
-            .min_by(|a, b| (a.1.msd_all_m2 + w * a.2).total_cmp(&(b.1.msd_all_m2 + w * b.2)))
-    }
-
-    /// The successful refinement with the lowest uncapped f_CONV, plus `w`
-    /// times its unexplained fraction when `w > 0`: `(index, result)`.
+    /// The successful refinement with the lowest score (see
+    /// [`Refinements::score`]): `(index, result)`; the first of equals.
     pub(super) fn best(&self, w: f64) -> Option<(usize, &Refined)> {
         self.successes()
             .min_by(|a, b| self.score(a.0, a.1, w).total_cmp(&self.score(b.0, b.1, w)))
     }
 
     /// The score of refinement `i`: its uncapped f_CONV plus `w` times its
-    /// unexplained fraction when `w > 0`.
+    /// unexplained fraction (in [0, 1], so `w = 0` ranks by f_CONV alone).
     pub(super) fn score(&self, i: usize, r: &Refined, w: f64) -> f64 {
-        if w > 0.0 {
-            r.msd_all_m2 + w * self.unexplained[i]
-        } else {
-            r.msd_all_m2
-        }
+        r.msd_all_m2 + w * self.unexplained[i]
     }
 
     /// The successful refinements with their indices.
@@ -135,6 +123,7 @@ mod tests {
             unexplained: list.iter().map(|l| l.2).collect(),
             refined: list.into_iter().map(|(a, m, _)| refined(a, m)).collect(),
             screened: 0,
+            ambiguous: false,
         }
     }
 

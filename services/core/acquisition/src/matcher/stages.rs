@@ -87,16 +87,13 @@ impl TemplateMatcher {
         let mut refinements = self.refine_candidates(&matched.ranked, &frame, &sensed_tree);
         self.add_second_chance(&mut refinements, &frame, &sensed_tree);
         let density = &self.levels[frame.density];
-        let ambiguous = self.add_twins(density, &mut refinements, &frame, &sensed_tree);
+        self.add_twins(density, &mut refinements, &frame, &sensed_tree);
         let timing = Timing {
             start,
             matching_ms,
             refinement_ms: ms_since(refine_start),
         };
-        let mut outcome = self.outcome(&frame, &matched, &refinements, timing);
-        outcome.twin_ambiguous = ambiguous;
-        outcome.accepted &= !ambiguous;
-        Ok(outcome)
+        Ok(self.outcome(&frame, &matched, &refinements, timing))
     }
 
     /// The finite points of `cloud`, thinned to the point budget (see
@@ -237,12 +234,13 @@ impl TemplateMatcher {
             refined,
             unexplained,
             screened,
+            ambiguous: false,
         }
     }
 
     /// The second chance (see [`crate::TemplateMatchingConfig::revote`]):
     /// when `revote` is on and the best refinement (see
-    /// [`Refinements::first_best`]) fails the acceptance test, each attempt
+    /// [`Refinements::best`]) fails the acceptance test, each attempt
     /// of `second_chance` is appended as a refinement of that candidate.
     pub(super) fn add_second_chance(
         &self,
@@ -251,7 +249,8 @@ impl TemplateMatcher {
         sensed_tree: &SensedTree,
     ) {
         let w = self.config.unexplained_weight_m2;
-        if let Some((i, r, u)) = refinements.first_best(w)
+        if let Some((i, r)) = refinements.best(w)
+            && let u = refinements.unexplained[i]
             && self.config.revote
             // The uncapped f_CONV decides whether to try again: a flip can
             // fit most points and still leave a few far off.
@@ -290,7 +289,8 @@ impl TemplateMatcher {
             correlation_m2: matched.correlation_of(chosen_k),
             f_conv_m2: chosen.f_conv_m2,
             unexplained_fraction: chosen.unexplained_fraction,
-            accepted: self.acceptable(chosen.f_conv_m2, chosen.unexplained_fraction),
+            accepted: self.acceptable(chosen.f_conv_m2, chosen.unexplained_fraction)
+                && !refinements.ambiguous,
             templates_generated: matched.generated,
             templates_evaluated: matched.evaluated,
             templates_rejected: matched.rejected,
@@ -305,7 +305,7 @@ impl TemplateMatcher {
             icp_converged: chosen.converged,
             icp_inlier_fraction: chosen.inlier_fraction,
             refinement_error: chosen.refinement_error,
-            twin_ambiguous: false,
+            twin_ambiguous: refinements.ambiguous,
         }
     }
 }

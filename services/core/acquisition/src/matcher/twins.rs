@@ -28,7 +28,7 @@ pub(super) const SAME_HYPOTHESIS_DEG: f64 = 10.0;
 
 impl TemplateMatcher {
     /// Adds the refinements of the twins of the current winner (see the
-    /// module documentation), when the check is on, and returns whether
+    /// module documentation), when the check is on, and records whether
     /// the result is ambiguous.
     pub(super) fn add_twins(
         &self,
@@ -36,14 +36,14 @@ impl TemplateMatcher {
         refinements: &mut Refinements,
         frame: &Frame,
         sensed: &SensedTree,
-    ) -> bool {
+    ) {
         let factor = self.config.twin_ambiguity;
         let w = self.config.unexplained_weight_m2;
         if factor <= 0.0 {
-            return false;
+            return;
         }
         let Some((i, best)) = refinements.best(w) else {
-            return false;
+            return;
         };
         let best = best.t_sensor_target;
         let stages = &self.config.icp_stages_m;
@@ -64,7 +64,8 @@ impl TemplateMatcher {
             };
             refinements.push(i, refined.map_err(|e| e.to_string()), u);
         }
-        refinements.is_ambiguous(w, factor, SAME_HYPOTHESIS_DEG.to_radians())
+        refinements.ambiguous =
+            refinements.is_ambiguous(w, factor, SAME_HYPOTHESIS_DEG.to_radians());
     }
 }
 
