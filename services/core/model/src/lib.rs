@@ -18,6 +18,7 @@ pub mod sampling;
 mod shapes;
 pub mod symmetry;
 mod target;
+pub mod zoo;
 
 pub use consistency::{RangeMargin, RayConsistency, ray_consistency};
 pub use error::TargetError;

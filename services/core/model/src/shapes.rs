@@ -22,22 +22,46 @@ pub(crate) fn regular_prism_x(
     side_material: MaterialId,
     cap_material: MaterialId,
 ) -> Result<Mesh, TargetError> {
+    frustum_x(
+        sides,
+        [radius_m, radius_m],
+        [x_min_m, x_max_m],
+        phase_rad,
+        side_material,
+        cap_material,
+    )
+}
+
+/// A frustum along x over regular `sides`-gons: circumradius `radii_m[0]`
+/// at `x_m[0]` and `radii_m[1]` at `x_m[1]` (a zero radius makes a cone;
+/// its cap's triangles have no area and are harmless). Vertex conventions
+/// and materials as [`regular_prism_x`].
+pub(crate) fn frustum_x(
+    sides: u32,
+    radii_m: [f64; 2],
+    x_m: [f64; 2],
+    phase_rad: f64,
+    side_material: MaterialId,
+    cap_material: MaterialId,
+) -> Result<Mesh, TargetError> {
     if sides < 3 {
         return Err(TargetError::InvalidMesh(format!(
             "a prism needs at least 3 sides, got {sides}"
         )));
     }
-    let ring = |x: f64| {
+    let ring = |x: f64, r: f64| {
         (0..sides).map(move |k| {
             let phi = phase_rad + std::f64::consts::TAU * f64::from(k) / f64::from(sides);
-            Vector3::new(x, radius_m * phi.cos(), radius_m * phi.sin())
+            Vector3::new(x, r * phi.cos(), r * phi.sin())
         })
     };
-    // Vertices: ring at x_min (0..n), ring at x_max (n..2n), cap centres 2n and 2n + 1.
+    // Vertices: ring at x_m[0] (0..n), ring at x_m[1] (n..2n), cap centres 2n and 2n + 1.
     let n = sides;
-    let mut vertices: Vec<Vector3<f64>> = ring(x_min_m).chain(ring(x_max_m)).collect();
-    vertices.push(Vector3::new(x_min_m, 0.0, 0.0));
-    vertices.push(Vector3::new(x_max_m, 0.0, 0.0));
+    let mut vertices: Vec<Vector3<f64>> = ring(x_m[0], radii_m[0])
+        .chain(ring(x_m[1], radii_m[1]))
+        .collect();
+    vertices.push(Vector3::new(x_m[0], 0.0, 0.0));
+    vertices.push(Vector3::new(x_m[1], 0.0, 0.0));
     let mut triangles = Vec::with_capacity(4 * n as usize);
     let mut materials = Vec::with_capacity(4 * n as usize);
     for k in 0..n {
@@ -52,7 +76,7 @@ pub(crate) fn regular_prism_x(
         triangles.push([2 * n + 1, n + k, n + k1]);
         materials.extend([cap_material, cap_material]);
     }
-    let interior = Vector3::new(0.5 * (x_min_m + x_max_m), 0.0, 0.0);
+    let interior = Vector3::new(0.5 * (x_m[0] + x_m[1]), 0.0, 0.0);
     let triangles = orient_outward(&vertices, triangles, &interior);
     Mesh::new(vertices, triangles, materials)
 }

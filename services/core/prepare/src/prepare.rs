@@ -62,7 +62,8 @@ impl Default for PrepareOptions {
     }
 }
 
-/// Prepares `spec` (a built-in name or a mesh file) into a package and
+/// Prepares `spec` (a built-in name, a mesh file, or `zoo:N` for the
+/// generated target of seed N) into a package and
 /// writes it to `out` when given; `progress(done, total)` follows the
 /// calibration.
 pub fn prepare(
@@ -145,6 +146,18 @@ pub(crate) fn load_source(
         );
         return Ok((target, r, fnv));
     }
+    if let Some(seed) = zoo_seed(spec)? {
+        if scale != 1.0 {
+            return Err(PrepareError::InvalidOption(format!(
+                "{spec}: a generated target is in metres; scale {scale} applies to mesh files only"
+            )));
+        }
+        let zoo = spacepose_model::zoo::generate(seed)?;
+        let source = format!("zoo:{seed}:v{}", spacepose_model::zoo::ZOO_VERSION);
+        let fnv = fnv1a64(OFFSET, source.as_bytes());
+        let r = record(source, Vector3::zeros(), &zoo.description);
+        return Ok((zoo.target, r, fnv));
+    }
     let path = Path::new(spec);
     let bytes = std::fs::read(path).map_err(|e| PrepareError::Io {
         path: path.to_owned(),
@@ -155,6 +168,19 @@ pub(crate) fn load_source(
     let conventions = "file axes; file units x source_scale = metres; origin moved to the \
                        area-weighted surface centroid (centre of mass of a uniform shell)";
     Ok((target, record(spec.to_owned(), origin, conventions), fnv))
+}
+
+/// The seed of a generated target's spec `zoo:N` (`None` for any other
+/// spec; an error for `zoo:` followed by something else than a number).
+pub fn zoo_seed(spec: &str) -> Result<Option<u64>, PrepareError> {
+    let Some(rest) = spec.strip_prefix("zoo:") else {
+        return Ok(None);
+    };
+    rest.parse().map(Some).map_err(|_| {
+        PrepareError::InvalidOption(format!(
+            "{spec:?}: a generated target is `zoo:N`, N a seed (a whole number)"
+        ))
+    })
 }
 
 /// A symmetry group, its twins, and their record.

@@ -7,7 +7,10 @@
 //! - a mesh file (or a built-in at another scale): prepared on first use
 //!   into the cache ([`cache_dir`]) and loaded from there afterwards; the
 //!   cache entry is keyed by the FNV-1a of the source bytes and the scale,
-//!   so an edited mesh is prepared again.
+//!   so an edited mesh is prepared again;
+//! - `zoo:N`: the generated spacecraft of seed N
+//!   (`spacepose_model::zoo`), prepared on first use into the cache like a
+//!   mesh file.
 
 use crate::error::PrepareError;
 use crate::prepare::{PrepareOptions, load_source, prepare};

@@ -3,6 +3,8 @@
 //! - `target prepare MESH|BUILTIN --out DIR`: loads the mesh, detects its
 //!   symmetry group, calibrates its thresholds from simulated frames, and
 //!   writes the package;
+//! - `target generate --seed N --out DIR`: the generated spacecraft of
+//!   seed N (`spacepose_model::zoo`), prepared the same way;
 //! - `target show SPEC`: prints what a package (or a built-in, or a mesh
 //!   prepared on the fly) records.
 
@@ -23,6 +25,20 @@ pub enum TargetCommand {
     Prepare(PrepareArgs),
     /// Print what a package, a built-in target or a mesh records.
     Show(ShowArgs),
+    /// Generate a plausible spacecraft from a seed (the target zoo) and
+    /// prepare it into a package; `zoo:N` names the same target anywhere.
+    Generate(GenerateArgs),
+}
+
+/// `spacepose target generate`.
+#[derive(Debug, Args)]
+pub struct GenerateArgs {
+    /// Seed of the design (`seed % 3`: 0 exactly symmetric, 1 nearly, 2 not).
+    #[arg(long)]
+    pub seed: u64,
+    /// The package directory to write.
+    #[arg(long)]
+    pub out: PathBuf,
 }
 
 /// `spacepose target prepare`.
@@ -63,6 +79,14 @@ pub struct ShowArgs {
 pub fn run(command: &TargetCommand) -> Result<()> {
     match command {
         TargetCommand::Prepare(args) => prepare(args),
+        TargetCommand::Generate(args) => prepare(&PrepareArgs {
+            mesh: format!("zoo:{}", args.seed),
+            scale: 1.0,
+            name: None,
+            out: args.out.clone(),
+            symmetry_tolerance: None,
+            symmetry: None,
+        }),
         TargetCommand::Show(args) => {
             let package = spacepose_prepare::resolve(&args.spec, args.scale)
                 .with_context(|| format!("target {}", args.spec))?;
@@ -141,10 +165,15 @@ pub fn summary(p: &TargetPackage) -> String {
         let v = q.scaled_axis().map(f64::to_degrees);
         format!("[{:.1}, {:.1}, {:.1}]", v.x, v.y, v.z)
     };
+    let design = if m.mesh.source.starts_with("zoo:") {
+        format!("  design: {}\n", m.mesh.conventions)
+    } else {
+        String::new()
+    };
     let group: Vec<String> = m.symmetry.group().iter().map(deg).collect();
     let twins: Vec<String> = m.symmetry.twins().iter().map(deg).collect();
     format!(
-        "target {} ({})\n  bounding radius {:.3} m, extent {:.2} x {:.2} x {:.2} m, {} triangles\n  \
+        "target {} ({})\n{design}  bounding radius {:.3} m, extent {:.2} x {:.2} x {:.2} m, {} triangles\n  \
          symmetry ({}): {} rotation(s) {}\n  twins: {}\n  calibration: max_mean_cost_ndt {:.2}, \
          min_inlier_fraction {:.3} ({} of {} frames; cost p50 {:.2}, p99 {:.2})\n",
         m.name,

@@ -40,8 +40,12 @@ pub(crate) enum Moments {
     Distinct([Unit<Vector3<f64>>; 3]),
     /// Two equal moments: the axis of the third.
     Axial(Unit<Vector3<f64>>),
-    /// Three equal moments: no preferred axis.
-    Isotropic,
+    /// Three moments equal within the gap: no preferred axis, but the
+    /// eigenvectors are kept. A body whose axial moment is only close to
+    /// its transverse ones (a 3-fold bus about as long as it is wide) has
+    /// an exact symmetry axis among them that no farthest vertex points
+    /// along.
+    Isotropic([Unit<Vector3<f64>>; 3]),
 }
 
 /// Second moment `∫ p pᵀ dA` of the surface about the body origin (m⁴): for
@@ -74,7 +78,7 @@ pub(crate) fn classify_moments(moment: &Matrix3<f64>, gap: f64) -> Moments {
         (false, false) => Moments::Distinct([axis(0), axis(1), axis(2)]),
         (true, false) => Moments::Axial(axis(2)),
         (false, true) => Moments::Axial(axis(0)),
-        (true, true) => Moments::Isotropic,
+        (true, true) => Moments::Isotropic([axis(0), axis(1), axis(2)]),
     }
 }
 
@@ -115,10 +119,10 @@ pub(crate) fn candidate_rotations(
             vec![*axis],
             in_plane_axes(mesh.vertices(), axis, radius, level),
         ),
-        Moments::Isotropic => {
+        Moments::Isotropic(axes) => {
             let far = farthest_directions(mesh.vertices(), radius, level);
             let sums = pair_sums(&far);
-            (far, sums)
+            (axes.iter().copied().chain(far).collect(), sums)
         }
     };
     let any_order = distinct_lines(any_order, &[]);

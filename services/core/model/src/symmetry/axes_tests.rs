@@ -31,7 +31,7 @@ fn moments_are_classified_by_their_coincidences() {
         other => panic!("{other:?}"),
     }
     let m = second_moment(&cuboid(Vector3::new(0.5, 0.5, 0.5)));
-    assert_eq!(classify_moments(&m, 0.1), Moments::Isotropic);
+    assert!(matches!(classify_moments(&m, 0.1), Moments::Isotropic(_)));
 }
 
 #[test]
