@@ -5,6 +5,20 @@
 //!
 //! Initialisations are applied at the next usable frame, so that the frame
 //! they belong to is tracked from them.
+//!
+//! **Late acquisitions are caught up.** Template matching can take longer
+//! than a frame period (0.2-0.9 s on one core, against 1 s frames, or
+//! 0.2 s when the demo runs five times faster than real time). An
+//! acquisition of frame k that arrives after frame k + 2 would start the
+//! track 20° off on a 10°/s tumble, with zero rates, and registration does
+//! not converge from there. So while the track waits for an acquisition,
+//! the usable points of the last [`CATCH_UP_FRAMES`] frames are kept; an
+//! acquisition whose time lies before some of them is applied to the first
+//! of those, and they are tracked in order (their estimates were already
+//! published as `lost` and are not sent again) before the frame at hand.
+//! Each step then starts one frame period from its pose, as an on-time
+//! acquisition does. Decision: replay rather than extrapolate, because an
+//! acquisition carries no rate.
 
 use crate::frame::FrameResult;
 use crate::wire::fill_estimate;
@@ -15,6 +29,11 @@ use spacepose_messages::convert::filter::zero_rates;
 use spacepose_tracker::{
     TrackError, TrackOutput, TrackStatus, Tracker, TrackerConfig, TrackingMode, TrackingModel,
 };
+use std::collections::VecDeque;
+
+/// Frames kept while waiting for an acquisition (see the module
+/// documentation): 10 s of sensor time at 1 Hz.
+pub const CATCH_UP_FRAMES: usize = 10;
 
 /// An initialisation applied at the next usable frame.
 #[derive(Debug, Clone, Copy)]
@@ -40,6 +59,9 @@ pub struct Track {
     /// tracker has processed the same frame, and restoring a state from the
     /// end of the scan about to be tracked would put the filter after it.
     pending_state: Option<Prediction>,
+    /// The last frames seen while not tracking, to catch up a late
+    /// acquisition.
+    recent: VecDeque<(CloudHeader, Vec<Point>)>,
 }
 
 impl Track {
@@ -52,6 +74,7 @@ impl Track {
             initialized: false,
             warm_start: true,
             pending_state: None,
+            recent: VecDeque::new(),
         })
     }
 
@@ -133,8 +156,50 @@ impl Track {
 
     /// Tracks the usable `points` of the frame of `header` and fills
     /// `result` (its estimate starts `lost`); returns the tracker's output
-    /// when the frame reached the tracker.
+    /// when the frame reached the tracker. A late acquisition is caught up
+    /// first (see the module documentation).
     pub fn track(
+        &mut self,
+        header: &CloudHeader,
+        points: &[Point],
+        result: &mut FrameResult,
+    ) -> Option<TrackOutput> {
+        self.catch_up(header);
+        let out = self.track_one(header, points, result);
+        if self.is_tracking() {
+            self.recent.clear();
+        } else {
+            if self.recent.len() == CATCH_UP_FRAMES {
+                self.recent.pop_front();
+            }
+            self.recent.push_back((*header, points.to_vec()));
+        }
+        out
+    }
+
+    /// Frames kept for a late acquisition.
+    pub fn kept_frames(&self) -> usize {
+        self.recent.len()
+    }
+
+    /// Tracks the kept frames that end after a pending acquisition's time
+    /// (its own frame ends at it) and before `header`'s frame, in order.
+    fn catch_up(&mut self, header: &CloudHeader) {
+        let Some(t) = self.pending.and_then(|p| p.t) else {
+            return;
+        };
+        let late: Vec<_> = std::mem::take(&mut self.recent)
+            .into_iter()
+            .filter(|(h, _)| h.scan_end_s > t + 1e-9 && h.scan_end_s <= header.scan_start_s)
+            .collect();
+        for (h, points) in &late {
+            let mut scratch = FrameResult::new(Default::default());
+            self.track_one(h, points, &mut scratch);
+        }
+    }
+
+    /// [`Self::track`] of one frame, without the catch-up.
+    fn track_one(
         &mut self,
         header: &CloudHeader,
         points: &[Point],
