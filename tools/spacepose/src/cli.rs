@@ -120,6 +120,15 @@ pub struct DemoArgs {
     /// Frames to run (lidar-sim's frame count).
     #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u64).range(1..))]
     pub frames: u64,
+    /// Run on this target instead of the descriptor's: a package directory,
+    /// a built-in name, a mesh file (prepared on first use) or `zoo:N`.
+    /// Every service takes its numbers from the package, and the sensor's
+    /// legs are moved out until the whole target is in view.
+    #[arg(long)]
+    pub target: Option<String>,
+    /// Scale of a mesh file given to --target (0.001 for millimetres).
+    #[arg(long, default_value_t = 1.0, requires = "target")]
+    pub scale: f64,
     /// Frames excluded from the converged error figures (filter warm-up).
     #[arg(long, default_value_t = 10)]
     pub warmup: usize,

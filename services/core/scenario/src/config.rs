@@ -80,6 +80,12 @@ pub struct ScenarioConfig {
     pub compression: f64,
     /// Range of the target centre of mass (m), random scenario only.
     pub range_m: f64,
+    /// Slow-spin and tumbling: every range of the chaser's legs (seed 000
+    /// §4.3-4.4: 15 m fly-around down to 3 m, set for a 1.6 m-radius
+    /// mockup) multiplied by this factor (>= 1), so that a larger target
+    /// is seen whole at the fly-around. Default 1 (the paper's legs).
+    #[serde(default = "unit_range_scale")]
+    pub range_scale: f64,
     /// Amplitude (deg, per sensor axis) of the smooth pointing error of the
     /// boresight, so the target is not always dead centre. Default 0.3°.
     pub pointing_error_deg: f64,
@@ -93,6 +99,10 @@ pub struct ScenarioConfig {
     /// loss-and-reacquisition variant); `None` (default) = never.
     #[serde(default)]
     pub look_away: Option<LookAway>,
+}
+
+fn unit_range_scale() -> f64 {
+    1.0
 }
 
 impl Default for ScenarioConfig {
@@ -116,6 +126,7 @@ impl ScenarioConfig {
             frame_period_s,
             compression: 1.0,
             range_m: 20.0,
+            range_scale: 1.0,
             pointing_error_deg: 0.3,
             lateral_offset_deg: 1.0,
             random_frames: 500,
@@ -134,6 +145,9 @@ impl ScenarioConfig {
         }
         if !(self.range_m.is_finite() && self.range_m > 0.0) {
             return Err(ScenarioError::InvalidRange(self.range_m));
+        }
+        if !(self.range_scale.is_finite() && self.range_scale >= 1.0) {
+            return Err(ScenarioError::InvalidRangeScale(self.range_scale));
         }
         if !(self.pointing_error_deg.is_finite() && (0.0..=5.0).contains(&self.pointing_error_deg))
         {

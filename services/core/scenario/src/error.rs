@@ -14,6 +14,9 @@ pub enum ScenarioError {
     /// The time compression is NaN, infinite or below 1.
     #[error("compression must be finite and >= 1, got {0}")]
     InvalidCompression(f64),
+    /// The legs' range scale is NaN, infinite or below 1.
+    #[error("range_scale must be finite and >= 1, got {0}")]
+    InvalidRangeScale(f64),
     /// The range of the random scenario is NaN, infinite, zero or negative.
     #[error("range must be finite and positive, got {0} m")]
     InvalidRange(f64),

@@ -37,64 +37,107 @@ pub const ELLIPSE_TUMBLE_AXIS: [f64; 3] = [0.48, -0.6, 0.64];
 /// Seed 000 §4.3 legs (trajectory time): fly-around at 15 m until 500 s,
 /// hold, 15 → 8 m over [550, 900] s (2 cm/s), hold, 8 → 3 m over
 /// [970, 1470] s (1 cm/s).
-pub fn slow_spin_legs() -> Vec<Leg> {
-    vec![
-        leg(0.0, 500.0, LegMotion::FlyAround { range_m: 15.0 }),
-        leg(500.0, 550.0, LegMotion::Hold { range_m: 15.0 }),
-        leg(
-            550.0,
-            900.0,
-            LegMotion::Approach {
-                from_m: 15.0,
-                to_m: 8.0,
-            },
-        ),
-        leg(900.0, 970.0, LegMotion::Hold { range_m: 8.0 }),
-        leg(
-            970.0,
-            1470.0,
-            LegMotion::Approach {
-                from_m: 8.0,
-                to_m: 3.0,
-            },
-        ),
-    ]
+pub fn slow_spin_legs(range_scale: f64) -> Vec<Leg> {
+    scaled(
+        range_scale,
+        vec![
+            leg(0.0, 500.0, LegMotion::FlyAround { range_m: 15.0 }),
+            leg(500.0, 550.0, LegMotion::Hold { range_m: 15.0 }),
+            leg(
+                550.0,
+                900.0,
+                LegMotion::Approach {
+                    from_m: 15.0,
+                    to_m: 8.0,
+                },
+            ),
+            leg(900.0, 970.0, LegMotion::Hold { range_m: 8.0 }),
+            leg(
+                970.0,
+                1470.0,
+                LegMotion::Approach {
+                    from_m: 8.0,
+                    to_m: 3.0,
+                },
+            ),
+        ],
+    )
 }
 
 /// Seed 000 §4.4 legs (trajectory time): fly-around at 15 m until 350 s,
 /// 15 → 8 m until 700 s (2 cm/s), hold 50 s, 8 → 4 m at 1 cm/s reaching 4 m
 /// at 1150 s, hold 80 s, 4 → 3 m at 1 cm/s, hold until 1380 s (23 min).
-pub fn tumbling_legs() -> Vec<Leg> {
-    vec![
-        leg(0.0, 350.0, LegMotion::FlyAround { range_m: 15.0 }),
-        leg(
-            350.0,
-            700.0,
-            LegMotion::Approach {
-                from_m: 15.0,
-                to_m: 8.0,
+pub fn tumbling_legs(range_scale: f64) -> Vec<Leg> {
+    scaled(
+        range_scale,
+        vec![
+            leg(0.0, 350.0, LegMotion::FlyAround { range_m: 15.0 }),
+            leg(
+                350.0,
+                700.0,
+                LegMotion::Approach {
+                    from_m: 15.0,
+                    to_m: 8.0,
+                },
+            ),
+            leg(700.0, 750.0, LegMotion::Hold { range_m: 8.0 }),
+            leg(
+                750.0,
+                1150.0,
+                LegMotion::Approach {
+                    from_m: 8.0,
+                    to_m: 4.0,
+                },
+            ),
+            leg(1150.0, 1230.0, LegMotion::Hold { range_m: 4.0 }),
+            leg(
+                1230.0,
+                1330.0,
+                LegMotion::Approach {
+                    from_m: 4.0,
+                    to_m: 3.0,
+                },
+            ),
+            leg(1330.0, 1380.0, LegMotion::Hold { range_m: 3.0 }),
+        ],
+    )
+}
+
+/// The legs with every range multiplied by `k`.
+fn scaled(k: f64, legs: Vec<Leg>) -> Vec<Leg> {
+    legs.into_iter()
+        .map(|l| Leg {
+            motion: match l.motion {
+                LegMotion::FlyAround { range_m } => LegMotion::FlyAround {
+                    range_m: range_m * k,
+                },
+                LegMotion::Hold { range_m } => LegMotion::Hold {
+                    range_m: range_m * k,
+                },
+                LegMotion::Approach { from_m, to_m } => LegMotion::Approach {
+                    from_m: from_m * k,
+                    to_m: to_m * k,
+                },
             },
-        ),
-        leg(700.0, 750.0, LegMotion::Hold { range_m: 8.0 }),
-        leg(
-            750.0,
-            1150.0,
-            LegMotion::Approach {
-                from_m: 8.0,
-                to_m: 4.0,
-            },
-        ),
-        leg(1150.0, 1230.0, LegMotion::Hold { range_m: 4.0 }),
-        leg(
-            1230.0,
-            1330.0,
-            LegMotion::Approach {
-                from_m: 4.0,
-                to_m: 3.0,
-            },
-        ),
-        leg(1330.0, 1380.0, LegMotion::Hold { range_m: 3.0 }),
-    ]
+            ..l
+        })
+        .collect()
+}
+
+/// The fly-around range of the slow-spin and tumbling legs at range scale 1 (m).
+pub const FLY_AROUND_RANGE_M: f64 = 15.0;
+
+/// The range scale at which a target of bounding radius `radius_m` is seen
+/// whole at the fly-around by a sensor of full field of view `fov_deg`:
+/// its bounding sphere within 80 % of the half field of view, never below
+/// 1 (the paper's legs). Decision: a target that overfills the field of
+/// view is seen in part, and template matching then accepts wrong poses
+/// (docs/design/target-packages.md); 80 % leaves room for the pointing
+/// error and the fly-around's parallax. deos (1.60 m) stays at 1 (it
+/// would fit from 6.1 m).
+pub fn range_scale_to_fit(radius_m: f64, fov_deg: f64) -> f64 {
+    let half = 0.8 * 0.5 * fov_deg.to_radians();
+    (radius_m / half.sin() / FLY_AROUND_RANGE_M).max(1.0)
 }
 
 fn leg(start_s: f64, end_s: f64, motion: LegMotion) -> Leg {
@@ -172,7 +215,7 @@ pub(crate) fn slow_spin(cfg: &ScenarioConfig) -> RelativeMotion {
         "slow-spin",
         cfg,
         ChaserTrajectory::Rendezvous {
-            legs: slow_spin_legs(),
+            legs: slow_spin_legs(cfg.range_scale),
         },
         attitude,
         &mut rng,
@@ -188,7 +231,7 @@ pub(crate) fn tumbling(cfg: &ScenarioConfig) -> RelativeMotion {
         "tumbling",
         cfg,
         ChaserTrajectory::Rendezvous {
-            legs: tumbling_legs(),
+            legs: tumbling_legs(cfg.range_scale),
         },
         attitude,
         &mut rng,

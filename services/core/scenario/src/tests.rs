@@ -358,3 +358,32 @@ fn build_rejects_invalid_configurations() {
         Err(ScenarioError::InvalidFramePeriod(_))
     ));
 }
+
+#[test]
+fn a_range_scale_moves_every_leg_out_and_fits_a_large_target() {
+    use crate::presets::{FLY_AROUND_RANGE_M, range_scale_to_fit};
+    for kind in [ScenarioKind::SlowSpin, ScenarioKind::Tumbling] {
+        let base = ScenarioConfig::default_for(kind);
+        let near = build(&base).unwrap();
+        let far = build(&ScenarioConfig {
+            range_scale: 2.5,
+            ..base.clone()
+        })
+        .unwrap();
+        for t in [0.0, 400.0, 1000.0] {
+            let (a, b) = (near.state_at(t), far.state_at(t));
+            let ratio = b.t_sensor_target.translation.norm() / a.t_sensor_target.translation.norm();
+            assert!((ratio - 2.5).abs() < 0.02, "{kind} at {t} s: {ratio}");
+        }
+        let bad = ScenarioConfig {
+            range_scale: 0.5,
+            ..base
+        };
+        assert!(build(&bad).is_err());
+    }
+    // deos (1.60 m) keeps the paper's legs; a 13 m radius fits at 49 m.
+    assert_eq!(range_scale_to_fit(1.6008, 38.4), 1.0);
+    let k = range_scale_to_fit(13.0, 38.4);
+    let half = (0.4 * 38.4f64).to_radians();
+    assert!((13.0 / (k * FLY_AROUND_RANGE_M) - half.sin()).abs() < 1e-12);
+}

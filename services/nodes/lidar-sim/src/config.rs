@@ -25,6 +25,11 @@ pub struct LidarSimConfig {
     pub compression: f64,
     /// Range of the random scenario (m).
     pub range_m: f64,
+    /// Slow-spin and tumbling: every range of the chaser's legs times this
+    /// (>= 1; 1 = seed 000's 15 m fly-around down to 3 m). `spacepose demo
+    /// --target` sets it so that the target is seen whole at the
+    /// fly-around (`spacepose_scenario::presets::range_scale_to_fit`).
+    pub range_scale: f64,
     /// Frames to publish; 0 = endless (the scenario restarts after its
     /// natural length, the sensor clock keeps running).
     pub frames: u64,
@@ -62,6 +67,7 @@ impl Default for LidarSimConfig {
             seed: 0,
             compression: 1.0,
             range_m: 20.0,
+            range_scale: 1.0,
             frames: 0,
             integration_time_s: SensorConfig::MID40_INTEGRATION_TIME_S,
             rate_hz: 1.0,
@@ -91,6 +97,12 @@ impl ServiceConfig for LidarSimConfig {
         positive("checkpoint_max_age_s", self.checkpoint_max_age_s)?;
         if let Some(look) = &self.look_away {
             look.validate().map_err(|e| e.to_string())?;
+        }
+        if !(self.range_scale.is_finite() && self.range_scale >= 1.0) {
+            return Err(format!(
+                "range_scale must be finite and >= 1, got {}",
+                self.range_scale
+            ));
         }
         if !(self.compression.is_finite() && self.compression >= 1.0) {
             return Err(format!(
@@ -124,6 +136,7 @@ impl LidarSimConfig {
         sc.seed = self.seed;
         sc.compression = self.compression;
         sc.range_m = self.range_m;
+        sc.range_scale = self.range_scale;
         sc.random_frames = sc.random_frames.max(self.frames as usize);
         sc.look_away = self.look_away;
         let scenario = spacepose_scenario::build(&sc).context("invalid scenario")?;

@@ -73,6 +73,11 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
     let opts = DemoOptions {
         deploy: a.deploy.clone(),
         frames: a.frames,
+        target: a
+            .target
+            .as_deref()
+            .map(|t| super::demo::target::TargetOverride::resolve(t, a.scale))
+            .transpose()?,
         warmup: a.warmup,
         json: a.json.clone(),
         overrides: overrides(&a.overrides),

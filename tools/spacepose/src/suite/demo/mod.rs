@@ -8,6 +8,7 @@
 pub mod chaos;
 pub mod report;
 pub mod score;
+pub mod target;
 
 use super::descriptor::Descriptor;
 use super::supervisor::Supervisor;
@@ -29,6 +30,8 @@ pub struct DemoOptions {
     pub deploy: PathBuf,
     /// Frames to run.
     pub frames: u64,
+    /// The target that replaces the descriptor's.
+    pub target: Option<target::TargetOverride>,
     /// Frames excluded from the converged figures.
     pub warmup: usize,
     /// Where to write the JSON summary.
@@ -61,10 +64,19 @@ pub fn fresh_prefix() -> String {
     format!("demo-{:08x}", h as u32)
 }
 
-/// The descriptor with the demo's overrides: prefix, zenoh endpoints, and
-/// every sensor's frame count.
+/// The descriptor with the demo's overrides: prefix, zenoh endpoints,
+/// every sensor's frame count, and the target.
 fn demo_descriptor(opts: &DemoOptions) -> Result<Descriptor> {
     let mut d = Descriptor::load(&opts.deploy)?;
+    if let Some(target) = &opts.target {
+        tracing::info!(
+            "target {} (bounding radius {:.2} m): the sensor's legs at {:.2} x seed 000's",
+            target.spec,
+            target.bounding_radius_m,
+            target.range_scale
+        );
+        target.apply(&mut d);
+    }
     let mut overrides = opts.overrides.clone();
     overrides.prefix.get_or_insert_with(fresh_prefix);
     overrides.apply(&mut d);
