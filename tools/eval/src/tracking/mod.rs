@@ -29,7 +29,7 @@ mod render;
 pub mod report;
 
 pub use args::{EvalTrackingArgs, Modes};
-pub use deployed::{DeployedSuite, SuiteConfigs};
+pub use deployed::{Answer, DeployedSuite, SuiteConfigs};
 pub use report::{DIVERGED_DEG, DIVERGED_M, FrameRecord, ModeReport, TrackingReport};
 
 use crate::common::{load_target, progress_bar};
@@ -41,7 +41,7 @@ use spacepose_lidar_sim_node::LidarSimConfig;
 use spacepose_lidar_sim_node::wire::{cloud_header, truth_acquisition};
 use spacepose_messages::Name;
 use spacepose_scenario::ScenarioKind;
-use spacepose_tracker::{TrackerConfig, TrackingMode};
+use spacepose_tracker::{TrackerConfig, TrackingMode, TrackingModel};
 use spacepose_tracker_node::TrackerServiceConfig;
 use std::path::Path;
 
@@ -98,23 +98,51 @@ pub fn evaluate(config: &EvalConfig) -> Result<TrackingReport> {
             config.first_frame
         );
     }
-    let base = suite_configs(config)?;
-    let (model, _) = base.tracker.build_model().context("building the NDT map")?;
-    let mut suites = config
-        .modes
-        .iter()
-        .map(|&mode| {
-            let mut c = base.clone();
-            c.tracker.tracker.mode = mode;
-            DeployedSuite::new(&c, model.clone())
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let setup = Setup::new(config)?;
+    let mut suites = setup.suites()?;
     let tracked = run_frames(config, &source, frames, &mut suites)?;
     Ok(tracked.report(config, source.scenario().name(), target.name(), frames))
 }
 
+/// The suites of an evaluation, one per mode, before any frame: their
+/// configurations and the tracker's model (built once, as each tracker
+/// service builds it from its config). The Criterion benchmark
+/// `tracking_cost` starts its suites from it too.
+pub struct Setup {
+    /// Per mode of the evaluation, the suite's configurations.
+    pub configs: Vec<SuiteConfigs>,
+    /// The tracker's model of the target.
+    pub model: TrackingModel,
+}
+
+impl Setup {
+    /// The setup of `config`'s modes on its target.
+    pub fn new(config: &EvalConfig) -> Result<Setup> {
+        let base = suite_configs(config)?;
+        let (model, _) = base.tracker.build_model().context("building the NDT map")?;
+        let configs = config
+            .modes
+            .iter()
+            .map(|&mode| {
+                let mut c = base.clone();
+                c.tracker.tracker.mode = mode;
+                c
+            })
+            .collect();
+        Ok(Setup { configs, model })
+    }
+
+    /// Fresh suites, one per mode.
+    pub fn suites(&self) -> Result<Vec<DeployedSuite>> {
+        self.configs
+            .iter()
+            .map(|c| DeployedSuite::new(c, self.model.clone()))
+            .collect()
+    }
+}
+
 /// The sensor's frames for `config` (the simulated sensor's own source).
-fn frame_source(config: &EvalConfig) -> Result<FrameSource> {
+pub fn frame_source(config: &EvalConfig) -> Result<FrameSource> {
     let sensor = LidarSimConfig {
         target: config.target.0.clone(),
         scale: config.target.1,
