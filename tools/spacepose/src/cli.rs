@@ -126,6 +126,10 @@ pub struct DemoArgs {
     /// legs are moved out until the whole target is in view.
     #[arg(long)]
     pub target: Option<String>,
+    /// Seed of the simulated sensor's scenario and noise (replaces the
+    /// descriptor's).
+    #[arg(long)]
+    pub seed: Option<u64>,
     /// Scale of a mesh file given to --target (0.001 for millimetres).
     #[arg(long, default_value_t = 1.0, requires = "target")]
     pub scale: f64,

@@ -142,3 +142,27 @@ fn the_symmetry_can_be_overridden_and_bad_input_is_refused() {
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o).contains("missing.stl"), "{}", text(&o));
 }
+
+#[test]
+fn a_generated_design_is_a_package_and_zoo_n_names_it_anywhere() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let cache = dir.path().join("cache");
+    let pkg = dir.path().join("zoo3");
+    let p = pkg.to_str().unwrap();
+    // Design 3 (a development design): exactly 2-fold about x.
+    let o = spacepose(&["target", "generate", "--seed", "3", "--out", p], &cache);
+    assert!(o.status.success(), "{}", text(&o));
+    let out = text(&o);
+    assert!(
+        out.contains("design: zoo-3 (generator v1, exactly 2-fold"),
+        "{out}"
+    );
+    assert!(out.contains("symmetry (detected): 2 rotation(s)"), "{out}");
+    // The spec zoo:3 gives the same package, prepared into the cache.
+    let o = spacepose(&["target", "show", "zoo:3"], &cache);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("target zoo-3 (zoo:3:v1)"), "{}", text(&o));
+    let o = spacepose(&["target", "show", "zoo:three"], &cache);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("`zoo:N`, N a seed"), "{}", text(&o));
+}

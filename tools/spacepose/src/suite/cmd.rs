@@ -73,6 +73,7 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
     let opts = DemoOptions {
         deploy: a.deploy.clone(),
         frames: a.frames,
+        seed: a.seed,
         target: a
             .target
             .as_deref()

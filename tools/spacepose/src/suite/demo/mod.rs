@@ -30,6 +30,8 @@ pub struct DemoOptions {
     pub deploy: PathBuf,
     /// Frames to run.
     pub frames: u64,
+    /// The sensor's seed, replacing the descriptor's.
+    pub seed: Option<u64>,
     /// The target that replaces the descriptor's.
     pub target: Option<target::TargetOverride>,
     /// Frames excluded from the converged figures.
@@ -65,7 +67,7 @@ pub fn fresh_prefix() -> String {
 }
 
 /// The descriptor with the demo's overrides: prefix, zenoh endpoints,
-/// every sensor's frame count, and the target.
+/// every sensor's frame count and seed, and the target.
 fn demo_descriptor(opts: &DemoOptions) -> Result<Descriptor> {
     let mut d = Descriptor::load(&opts.deploy)?;
     if let Some(target) = &opts.target {
@@ -85,6 +87,10 @@ fn demo_descriptor(opts: &DemoOptions) -> Result<Descriptor> {
     for s in d.instances_of_mut(ServiceKind::LidarSim) {
         s.config
             .insert("frames".into(), toml::Value::Integer(frames));
+        if let Some(seed) = opts.seed {
+            let seed = i64::try_from(seed).context("--seed is too large")?;
+            s.config.insert("seed".into(), toml::Value::Integer(seed));
+        }
         sensors += 1;
     }
     if sensors != 1 {
