@@ -77,19 +77,9 @@ fn track_measured(suite: &mut DeployedSuite, frames: &[Frame]) -> Vec<Answer> {
 
 fn config(target: &str, mode: TrackingMode) -> EvalConfig {
     EvalConfig {
-        scenario: ScenarioKind::Tumbling,
-        modes: vec![mode],
         frames: Some(WARM_FRAMES + MEASURED),
-        seed: 1,
-        compression: 1.0,
-        first_frame: 0,
-        target: (target.to_owned(), 1.0),
         warmup: 0,
-        min_lever_arm_m: None,
-        geometric_sigma_m: None,
-        ct_start: None,
-        tracker: None,
-        ingest: None,
+        ..EvalConfig::new((target.to_owned(), 1.0), ScenarioKind::Tumbling, vec![mode])
     }
 }
 

@@ -127,19 +127,14 @@ fn run_suite() -> BTreeMap<u64, PoseEstimate> {
 fn the_suite_and_eval_tracking_publish_the_same_poses() {
     let suite = run_suite();
     let report = evaluate(&EvalConfig {
-        scenario: ScenarioKind::Tumbling,
-        modes: vec![TrackingMode::Deblur],
         frames: Some(FRAMES as usize),
         seed: SEED,
-        compression: 1.0,
-        first_frame: 0,
-        target: ("deos".into(), 1.0),
         warmup: 0,
-        min_lever_arm_m: None,
-        geometric_sigma_m: None,
-        ct_start: None,
-        tracker: None,
-        ingest: None,
+        ..EvalConfig::new(
+            ("deos".into(), 1.0),
+            ScenarioKind::Tumbling,
+            vec![TrackingMode::Deblur],
+        )
     })
     .expect("eval tracking runs");
     let eval = &report.modes["deblur"].series;

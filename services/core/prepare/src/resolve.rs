@@ -21,18 +21,22 @@ use std::path::{Path, PathBuf};
 /// Resolves `spec` (see the module documentation), preparing into
 /// [`cache_dir`] when needed.
 pub fn resolve(spec: &str, scale: f64) -> Result<TargetPackage, PrepareError> {
-    let path = Path::new(spec);
-    if is_package_dir(path) {
-        return load_dir(path, scale);
-    }
-    if let Some(package) = builtin_package(spec, scale)? {
-        return Ok(package);
-    }
-    resolve_in(spec, scale, &cache_dir()?)
+    resolve_with(spec, scale, cache_dir)
 }
 
 /// [`resolve`] with an explicit cache directory.
 pub fn resolve_in(spec: &str, scale: f64, cache: &Path) -> Result<TargetPackage, PrepareError> {
+    resolve_with(spec, scale, || Ok(cache.to_owned()))
+}
+
+/// [`resolve`], asking for the cache directory only when a mesh file or a
+/// generated design must be prepared (a package directory or a built-in
+/// needs none).
+fn resolve_with(
+    spec: &str,
+    scale: f64,
+    cache: impl FnOnce() -> Result<PathBuf, PrepareError>,
+) -> Result<TargetPackage, PrepareError> {
     let path = Path::new(spec);
     if is_package_dir(path) {
         return load_dir(path, scale);
@@ -41,7 +45,7 @@ pub fn resolve_in(spec: &str, scale: f64, cache: &Path) -> Result<TargetPackage,
         return Ok(package);
     }
     let (target, _, fnv) = load_source(spec, scale)?;
-    let entry = cache
+    let entry = cache()?
         .join("targets")
         .join(format!("{}-{fnv:016x}", target.name()));
     if is_package_dir(&entry) {

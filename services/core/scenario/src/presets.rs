@@ -130,14 +130,19 @@ pub const FLY_AROUND_RANGE_M: f64 = 15.0;
 /// The range scale at which a target of bounding radius `radius_m` is seen
 /// whole at the fly-around by a sensor of full field of view `fov_deg`:
 /// its bounding sphere within 80 % of the half field of view, never below
-/// 1 (the paper's legs). Decision: a target that overfills the field of
-/// view is seen in part, and template matching then accepts wrong poses
+/// 1 (the paper's legs), and the whole sphere within `max_range_m` (the
+/// suite's range gate: ingest drops points beyond it), which wins.
+/// Decision: a target that overfills the field of view is seen in part,
+/// and template matching then accepts wrong poses
 /// (docs/design/target-packages.md); 80 % leaves room for the pointing
 /// error and the fly-around's parallax. deos (1.60 m) stays at 1 (it
-/// would fit from 6.1 m).
-pub fn range_scale_to_fit(radius_m: f64, fov_deg: f64) -> f64 {
+/// would fit from 6.1 m); envisat (21.1 m about its body centre) would fit
+/// from 80 m but is held at 38.9 m by a 60 m gate.
+pub fn range_scale_to_fit(radius_m: f64, fov_deg: f64, max_range_m: f64) -> f64 {
     let half = 0.8 * 0.5 * fov_deg.to_radians();
-    (radius_m / half.sin() / FLY_AROUND_RANGE_M).max(1.0)
+    let fit = radius_m / half.sin() / FLY_AROUND_RANGE_M;
+    let gate = (max_range_m - radius_m) / FLY_AROUND_RANGE_M;
+    fit.min(gate).max(1.0)
 }
 
 fn leg(start_s: f64, end_s: f64, motion: LegMotion) -> Leg {

@@ -381,9 +381,12 @@ fn a_range_scale_moves_every_leg_out_and_fits_a_large_target() {
         };
         assert!(build(&bad).is_err());
     }
-    // deos (1.60 m) keeps the paper's legs; a 13 m radius fits at 49 m.
-    assert_eq!(range_scale_to_fit(1.6008, 38.4), 1.0);
-    let k = range_scale_to_fit(13.0, 38.4);
+    // deos (1.60 m) keeps the paper's legs; a 10 m radius fits at 38 m;
+    // envisat's 21.1 m would fit at 80 m but stays within a 60 m gate.
+    assert_eq!(range_scale_to_fit(1.6008, 38.4, 60.0), 1.0);
+    let k = range_scale_to_fit(10.0, 38.4, 60.0);
     let half = (0.4 * 38.4f64).to_radians();
-    assert!((13.0 / (k * FLY_AROUND_RANGE_M) - half.sin()).abs() < 1e-12);
+    assert!((10.0 / (k * FLY_AROUND_RANGE_M) - half.sin()).abs() < 1e-12);
+    let k = range_scale_to_fit(21.1, 38.4, 60.0);
+    assert!((k * FLY_AROUND_RANGE_M + 21.1 - 60.0).abs() < 1e-12);
 }

@@ -78,6 +78,30 @@ pub struct EvalConfig {
     pub ingest: Option<IngestServiceConfig>,
 }
 
+impl EvalConfig {
+    /// `modes` on `scenario` with `target` (name or path, scale), with the
+    /// command line's defaults for the rest: the whole scenario, seed 1,
+    /// no compression, from the first frame, 10 warm-up frames, the
+    /// services' default configurations.
+    pub fn new(target: (String, f64), scenario: ScenarioKind, modes: Vec<TrackingMode>) -> Self {
+        EvalConfig {
+            scenario,
+            modes,
+            frames: None,
+            seed: 1,
+            compression: 1.0,
+            first_frame: 0,
+            target,
+            warmup: 10,
+            min_lever_arm_m: None,
+            geometric_sigma_m: None,
+            ct_start: None,
+            tracker: None,
+            ingest: None,
+        }
+    }
+}
+
 /// Runs the evaluation.
 pub fn evaluate(config: &EvalConfig) -> Result<TrackingReport> {
     if !matches!(

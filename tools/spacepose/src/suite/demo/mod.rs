@@ -71,13 +71,12 @@ pub fn fresh_prefix() -> String {
 fn demo_descriptor(opts: &DemoOptions) -> Result<Descriptor> {
     let mut d = Descriptor::load(&opts.deploy)?;
     if let Some(target) = &opts.target {
+        let range_scale = target.apply(&mut d);
         tracing::info!(
-            "target {} (bounding radius {:.2} m): the sensor's legs at {:.2} x seed 000's",
+            "target {} (bounding radius {:.2} m): the sensor's legs at {range_scale:.2} x seed 000's",
             target.spec,
             target.bounding_radius_m,
-            target.range_scale
         );
-        target.apply(&mut d);
     }
     let mut overrides = opts.overrides.clone();
     overrides.prefix.get_or_insert_with(fresh_prefix);

@@ -8,10 +8,12 @@
 //! directory, or the built-in name), so none prepares it again: the
 //! simulated sensor, ingest, the trackers and init take their numbers from
 //! the package. The sensor's legs are moved out so that the whole target
-//! is in view at the fly-around (`range_scale_to_fit`).
+//! is in view at the fly-around and within ingest's range gate
+//! (`range_scale_to_fit`).
 
 use super::super::descriptor::Descriptor;
 use anyhow::{Context, Result};
+use spacepose_ingest::IngestConfig;
 use spacepose_lidar_sim::pattern::MID40_FOV_DEG;
 use spacepose_messages::ServiceKind;
 use spacepose_scenario::presets::range_scale_to_fit;
@@ -23,9 +25,7 @@ pub struct TargetOverride {
     /// The spec every service loads: the package directory, or a built-in
     /// name at scale 1.
     pub spec: String,
-    /// The sensor's range scale.
-    pub range_scale: f64,
-    /// The package's bounding radius (m), for the log.
+    /// The package's bounding radius (m).
     pub bounding_radius_m: f64,
 }
 
@@ -41,22 +41,33 @@ impl TargetOverride {
                 .into_owned(),
             None => spec.to_owned(),
         };
-        let radius = package.target.bounding_radius();
         Ok(TargetOverride {
             spec,
-            range_scale: range_scale_to_fit(radius, MID40_FOV_DEG),
-            bounding_radius_m: radius,
+            bounding_radius_m: package.target.bounding_radius(),
         })
     }
 
-    /// Sets the target of every service that takes one.
-    pub fn apply(&self, d: &mut Descriptor) {
+    /// The sensor's range scale in `d`: the target in view and within
+    /// ingest's range gate (`max_range_m`, the smallest of the
+    /// descriptor's ingest services, else ingest's default).
+    pub fn range_scale(&self, d: &Descriptor) -> f64 {
+        let gate = d
+            .instances_of(ServiceKind::Ingest)
+            .filter_map(|s| s.config.get("max_range_m").and_then(Value::as_float))
+            .fold(IngestConfig::default().max_range_m, f64::min);
+        range_scale_to_fit(self.bounding_radius_m, MID40_FOV_DEG, gate)
+    }
+
+    /// Sets the target of every service that takes one, and the sensor's
+    /// range scale; returns the range scale.
+    pub fn apply(&self, d: &mut Descriptor) -> f64 {
+        let range_scale = self.range_scale(d);
         let spec = Value::String(self.spec.clone());
         for s in d.instances_of_mut(ServiceKind::LidarSim) {
             s.config.insert("target".into(), spec.clone());
             s.config.insert("scale".into(), Value::Float(1.0));
             s.config
-                .insert("range_scale".into(), Value::Float(self.range_scale));
+                .insert("range_scale".into(), Value::Float(range_scale));
         }
         for kind in [ServiceKind::Ingest, ServiceKind::Tracker, ServiceKind::Init] {
             for s in d.instances_of_mut(kind) {
@@ -64,6 +75,7 @@ impl TargetOverride {
                 s.config.insert("target_scale".into(), Value::Float(1.0));
             }
         }
+        range_scale
     }
 }
 
@@ -79,8 +91,9 @@ mod tests {
         )))
         .expect("demo.toml");
         let o = TargetOverride::resolve("envisat", 1.0).expect("envisat");
-        assert!(o.range_scale > 4.0, "{o:?}");
-        o.apply(&mut d);
+        let range_scale = o.apply(&mut d);
+        // In view from 80 m, but held within ingest's 60 m gate.
+        assert!((range_scale * 15.0 + o.bounding_radius_m - 60.0).abs() < 1e-9);
         let mut set = 0;
         for s in &d.services {
             if let Some(t) = s.config.get("target") {
@@ -94,9 +107,9 @@ mod tests {
             .next()
             .expect("sensor");
         let scale = sensor.config.get("range_scale").and_then(Value::as_float);
-        assert_eq!(scale, Some(o.range_scale));
+        assert_eq!(scale, Some(range_scale));
         let deos = TargetOverride::resolve("deos", 1.0).expect("deos");
-        assert_eq!(deos.range_scale, 1.0);
+        assert_eq!(deos.range_scale(&d), 1.0);
         let err = TargetOverride::resolve("no/such/mesh.stl", 1.0).unwrap_err();
         assert!(format!("{err:#}").contains("no/such/mesh.stl"), "{err:#}");
     }
