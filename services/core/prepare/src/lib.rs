@@ -27,5 +27,5 @@ pub mod resolve;
 
 pub use calibrate::{CalibrationOptions, calibrate};
 pub use error::PrepareError;
-pub use prepare::{PrepareOptions, SymmetryChoice, length_unit_m, prepare, zoo_seed};
+pub use prepare::{PrepareOptions, SymmetryChoice, length_unit_m, prepare};
 pub use resolve::{builtin_package, cache_dir, resolve, resolve_in};

@@ -172,7 +172,7 @@ pub(crate) fn load_source(
 
 /// The seed of a generated target's spec `zoo:N` (`None` for any other
 /// spec; an error for `zoo:` followed by something else than a number).
-pub fn zoo_seed(spec: &str) -> Result<Option<u64>, PrepareError> {
+fn zoo_seed(spec: &str) -> Result<Option<u64>, PrepareError> {
     let Some(rest) = spec.strip_prefix("zoo:") else {
         return Ok(None);
     };

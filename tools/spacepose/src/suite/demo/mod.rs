@@ -198,7 +198,12 @@ pub fn run(opts: &DemoOptions, out: &mut dyn Write) -> Result<Summary> {
             at_ns: 0,
         })
         .collect();
-    let scorer = Scorer::with_symmetries(target_symmetries(&d));
+    // The group of the package resolved for --target, else the descriptor's.
+    let symmetries = opts
+        .target
+        .as_ref()
+        .map_or_else(|| target_symmetries(&d), |t| t.symmetries.clone());
+    let scorer = Scorer::with_symmetries(symmetries);
     let followed = follow(opts, &bus, &ports, &mut sup, &mut injections, scorer, out);
     // Frozen processes cannot stop: thaw them first.
     for i in injections.iter().filter(|i| i.spec.action == Action::Stop) {

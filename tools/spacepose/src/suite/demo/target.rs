@@ -27,6 +27,8 @@ pub struct TargetOverride {
     pub spec: String,
     /// The package's bounding radius (m).
     pub bounding_radius_m: f64,
+    /// The package's symmetry group, for scoring.
+    pub symmetries: Vec<nalgebra::Rotation3<f64>>,
 }
 
 impl TargetOverride {
@@ -44,6 +46,7 @@ impl TargetOverride {
         Ok(TargetOverride {
             spec,
             bounding_radius_m: package.target.bounding_radius(),
+            symmetries: package.target.symmetries().to_vec(),
         })
     }
 
@@ -110,6 +113,7 @@ mod tests {
         assert_eq!(scale, Some(range_scale));
         let deos = TargetOverride::resolve("deos", 1.0).expect("deos");
         assert_eq!(deos.range_scale(&d), 1.0);
+        assert_eq!(deos.symmetries.len(), 3, "deos's ±120° group");
         let err = TargetOverride::resolve("no/such/mesh.stl", 1.0).unwrap_err();
         assert!(format!("{err:#}").contains("no/such/mesh.stl"), "{err:#}");
     }
