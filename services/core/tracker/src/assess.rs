@@ -76,13 +76,14 @@ pub(crate) fn inconsistency(
 /// lost seed 1's tumble in a sparse stretch, its rate hardly corrected).
 pub(crate) fn attitude_scaled(
     c: &TrackerConfig,
+    mode: TrackingMode,
     covariance: Matrix6<f64>,
     compensated: bool,
 ) -> Matrix6<f64> {
     if compensated {
         return covariance;
     }
-    let d = attitude_scaling(ct_attitude_scale(c));
+    let d = attitude_scaling(ct_attitude_scale(c, mode));
     d * covariance * d
 }
 

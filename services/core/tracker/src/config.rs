@@ -115,6 +115,13 @@ pub struct TrackerConfig {
     /// frame stays `degraded` and is not fused).
     /// Default true.
     pub ct_ndt_stall_fallback: bool,
+    /// `deblur`'s start-up (not in the paper; `crate::start_up`): while the
+    /// blur left by the filter's angular-rate uncertainty over a scan
+    /// (`σ_ω,max · scan duration`, deg) is above this, a `deblur` frame is
+    /// fitted as `ct-ndt` fits it (flagged `TrackOutput::start_up`). 0: the
+    /// paper's `deblur` from the first frame. Default
+    /// [`DEFAULT_DEBLUR_START_UP_BLUR_DEG`].
+    pub deblur_start_up_blur_deg: f64,
     /// Relative-motion filter tuning.
     pub filter: FilterConfig,
     /// Degraded / lost thresholds.
@@ -185,6 +192,9 @@ pub const DEFAULT_ICP_MODE_MIN_LEVER_ARM_M: f64 = 0.055;
 /// [`TrackerConfig::ndt`].
 pub const DEFAULT_MIN_LEVER_ARM_M: f64 = 0.035;
 
+/// Default of [`TrackerConfig::deblur_start_up_blur_deg`] (deg).
+pub const DEFAULT_DEBLUR_START_UP_BLUR_DEG: f64 = 1.0;
+
 impl Default for TrackerConfig {
     fn default() -> Self {
         Self {
@@ -205,6 +215,7 @@ impl Default for TrackerConfig {
             ct_ndt_min_points: DEFAULT_CT_NDT_MIN_POINTS,
             ct_ndt_motion_prior_weight: DEFAULT_CT_NDT_MOTION_PRIOR_WEIGHT,
             ct_ndt_stall_fallback: true,
+            deblur_start_up_blur_deg: DEFAULT_DEBLUR_START_UP_BLUR_DEG,
             // The tracker checks consistency with absolute innovation limits
             // (`LossConfig`): the registration's information is far more
             // confident than the model errors justify, so a χ² gate on it
@@ -255,6 +266,10 @@ impl TrackerConfig {
         let w = self.ct_ndt_motion_prior_weight;
         if !(w.is_finite() && w >= 0.0) {
             return Err(bad("ct_ndt_motion_prior_weight must be finite and >= 0", w));
+        }
+        let b = self.deblur_start_up_blur_deg;
+        if !(b.is_finite() && b >= 0.0) {
+            return Err(bad("deblur_start_up_blur_deg must be finite and >= 0", b));
         }
         let n = self.ndt_mode_min_lever_arm_m;
         if !(n.is_finite() && n >= 0.0) {

@@ -29,10 +29,10 @@ pub(crate) fn attitude_scaling(s: f64) -> Matrix6<f64> {
     Matrix6::from_diagonal(&Vector6::new(r, r, r, 1.0, 1.0, 1.0))
 }
 
-/// `TrackerConfig::ct_ndt_attitude_covariance_scale` in `ct-ndt` mode, 1
-/// otherwise.
-pub(crate) fn ct_attitude_scale(c: &TrackerConfig) -> f64 {
-    match c.mode {
+/// `TrackerConfig::ct_ndt_attitude_covariance_scale` for a frame fitted as
+/// `ct-ndt` fits it (`mode`, see `crate::start_up`), 1 otherwise.
+pub(crate) fn ct_attitude_scale(c: &TrackerConfig, mode: TrackingMode) -> f64 {
+    match mode {
         TrackingMode::CtNdt => c.ct_ndt_attitude_covariance_scale,
         _ => 1.0,
     }
@@ -70,6 +70,9 @@ pub(crate) struct Dispatch<'a> {
     pub(crate) config: &'a TrackerConfig,
     pub(crate) model: &'a TrackingModel,
     pub(crate) filter: &'a RelativeMotionFilter,
+    /// The frame's registration: the configured mode's, or `ct-ndt`'s in
+    /// `deblur`'s start-up (`crate::start_up::frame_mode`).
+    pub(crate) mode: TrackingMode,
     /// From [`ndt_params`].
     pub(crate) ndt: NdtParams,
 }
@@ -88,7 +91,7 @@ impl Dispatch<'_> {
         let previous = last.t_sensor_target.inverse();
         let predicted = prediction.pose.inverse();
         let (map, c, ndt) = (&self.model.map, self.config, &self.ndt);
-        Ok(match c.mode {
+        Ok(match self.mode {
             // A held rotation is moved from the guess (the previous pose)
             // to the prediction, as in `icp` mode: where no rate has been
             // fitted it would otherwise stand still.
@@ -143,7 +146,7 @@ impl Dispatch<'_> {
         let cov = a * at_start.covariance * a.transpose();
         let cov = (cov + cov.transpose()) * 0.5;
         // Undo what the measurements were inflated by before the filter.
-        let d = attitude_scaling(ct_attitude_scale(self.config)).try_inverse();
+        let d = attitude_scaling(ct_attitude_scale(self.config, self.mode)).try_inverse();
         let scale = self.filter.config().registration_covariance_scale;
         let information = d
             .map(|d| d * cov * d)
@@ -195,7 +198,7 @@ impl Dispatch<'_> {
         let rate = RatePrior {
             // R^e (R^s)ᵀ of t_target_sensor: Exp(-ω Δt) in the target frame.
             turn: at_end.pose.rotation.inverse() * at_start.pose.rotation,
-            information: information(cov_w, scale * ct_attitude_scale(self.config))?,
+            information: information(cov_w, scale * ct_attitude_scale(self.config, self.mode))?,
         };
         let displacement = DisplacementPrior {
             displacement_m: at_end.pose.translation - at_start.pose.translation,

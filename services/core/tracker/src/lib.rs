@@ -32,6 +32,7 @@ pub mod mode;
 pub mod model;
 pub mod output;
 pub mod pipeline;
+mod start_up;
 pub mod status;
 pub mod tracker;
 

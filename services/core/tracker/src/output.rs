@@ -58,6 +58,10 @@ pub struct TrackOutput {
     /// motion-compensated by the prediction, as `deblur` computes it
     /// ([`crate::TrackerConfig::ct_ndt_stall_fallback`]).
     pub fallback: bool,
+    /// `deblur` mode: fitted as `ct-ndt` fits it, the filter's angular rate
+    /// being still too uncertain to compensate the scan
+    /// ([`crate::TrackerConfig::deblur_start_up_blur_deg`]).
+    pub start_up: bool,
 }
 
 impl TrackOutput {
@@ -82,6 +86,7 @@ impl TrackOutput {
                 ..Timings::default()
             },
             fallback: false,
+            start_up: false,
         }
     }
 

@@ -117,6 +117,7 @@ mod tests {
                 total_ms: 3.5,
             },
             fallback: false,
+            start_up: false,
         };
         fill_estimate(&mut e, &out);
         assert_eq!(e.wire_status().unwrap(), WireStatus::Degraded);

@@ -69,6 +69,9 @@ pub struct FrameRecord {
     /// `ct-ndt` mode: CT-NDT stalled and the frame was fitted as `deblur`
     /// fits it (`TrackerConfig::ct_ndt_stall_fallback`).
     pub fallback: bool,
+    /// `deblur` mode: fitted by CT-NDT in the start-up
+    /// (`TrackerConfig::deblur_start_up_blur_deg`).
+    pub start_up: bool,
 }
 
 /// Summary of one mode (the columns of seed 000 Tables 2-3).
@@ -174,6 +177,7 @@ pub fn record(
         reason: out.map_or_else(String::new, |o| o.reason.clone()),
         blur_lag_deg: f64::NAN,
         fallback: out.is_some_and(|o| o.fallback),
+        start_up: out.is_some_and(|o| o.start_up),
     }
 }
 

@@ -6,6 +6,7 @@ use crate::assess::stalled;
 use crate::dispatch::LastPose;
 use crate::mode::TrackingMode;
 use crate::pipeline::Prepared;
+use crate::start_up::frame_mode;
 use spacepose_filter::Prediction;
 use spacepose_geometry::Point;
 use spacepose_registration::{Registration, ScanTimes};
@@ -20,6 +21,8 @@ pub(super) struct Measured {
     pub(super) points_used: usize,
     /// Fitted by the stall fallback.
     pub(super) fallback: bool,
+    /// The frame's registration (`crate::start_up::frame_mode`).
+    pub(super) mode: TrackingMode,
     pub(super) preprocess_ms: f64,
     /// Registration, the fallback included.
     pub(super) registration_ms: f64,
@@ -60,9 +63,10 @@ impl Tracker {
     ) -> Result<Measured, Missing> {
         let pre = Instant::now();
         let c = &self.config;
+        let mode = frame_mode(c, prediction, scan);
         let Prepared { cloud, compensated } = self
             .pipeline
-            .prepare(points, c.mode, c.ct_ndt_min_points, prediction)
+            .prepare(points, mode, c.ct_ndt_min_points, prediction)
             .map_err(|e| Missing::because(e.to_string()))?;
         let preprocess_ms = ms(pre);
         if cloud.len() < self.config.loss.min_points {
@@ -81,11 +85,17 @@ impl Tracker {
         }
         let reg_start = Instant::now();
         let registration = self
-            .dispatch()
+            .dispatch(mode)
             .register(&cloud, compensated, prediction, last, scan)
             .map_err(|e| Missing::because(e.to_string()))?;
-        let fallback =
-            self.stall_fallback(points, &registration, compensated, prediction, last, scan);
+        let fallback = self.stall_fallback(
+            points,
+            &registration,
+            (mode, compensated),
+            prediction,
+            last,
+            scan,
+        );
         let (registration, compensated, points_used, fallback) = match fallback {
             Some((r, n)) => (r, true, n, true),
             None => (registration, compensated, cloud.len(), false),
@@ -95,6 +105,7 @@ impl Tracker {
             compensated,
             points_used,
             fallback,
+            mode,
             preprocess_ms,
             registration_ms: ms(reg_start),
         })
@@ -108,13 +119,13 @@ impl Tracker {
         &mut self,
         points: &[Point],
         registration: &Registration,
-        compensated: bool,
+        (mode, compensated): (TrackingMode, bool),
         prediction: &Prediction,
         last: &LastPose,
         scan: &ScanTimes,
     ) -> Option<(Registration, usize)> {
         let c = &self.config;
-        if c.mode != TrackingMode::CtNdt
+        if mode != TrackingMode::CtNdt
             || compensated
             || !c.ct_ndt_stall_fallback
             || !stalled(&c.loss, registration)
@@ -123,7 +134,7 @@ impl Tracker {
         }
         let cloud = self.pipeline.compensated(points, prediction).ok()?;
         match self
-            .dispatch()
+            .dispatch(mode)
             .register(&cloud, true, prediction, last, scan)
         {
             Ok(r) => {

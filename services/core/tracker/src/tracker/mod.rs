@@ -178,8 +178,10 @@ impl Tracker {
         self.holding = m.registration.degenerate_directions > 0;
         let registration = self.held.follow(scan_end, m.registration);
         let counts = (points.len(), m.points_used);
-        let mut out = self.assess(registration, m.compensated, &prediction, scan_end, counts)?;
+        let fitted = (m.mode, m.compensated);
+        let mut out = self.assess(registration, fitted, &prediction, scan_end, counts)?;
         out.fallback = m.fallback;
+        out.start_up = m.mode != self.config.mode;
         self.record_tracked(&out);
         out.timings = Timings {
             preprocess_ms: m.preprocess_ms,
@@ -202,14 +204,16 @@ impl Tracker {
         }
     }
 
-    /// The registration of the current mode, with the degeneracy
-    /// handling's threshold in force (hysteresis while a rotation is held).
-    pub(crate) fn dispatch(&self) -> Dispatch<'_> {
+    /// The registration of `mode` (the frame's: `crate::start_up`), with the
+    /// degeneracy handling's threshold in force (hysteresis while a
+    /// rotation is held).
+    pub(crate) fn dispatch(&self, mode: TrackingMode) -> Dispatch<'_> {
         let following = self.held.following().then(|| self.held.min_lever_arm_m());
         Dispatch {
             config: &self.config,
             model: &self.model,
             filter: &self.filter,
+            mode,
             ndt: ndt_params(&self.config, self.holding, following),
         }
     }
@@ -220,7 +224,7 @@ impl Tracker {
     fn assess(
         &mut self,
         registration: Registration,
-        compensated: bool,
+        (mode, compensated): (TrackingMode, bool),
         prediction: &Prediction,
         t: f64,
         (points_in, points_used): (usize, usize),
@@ -231,7 +235,7 @@ impl Tracker {
         let innovation_pos_m = (measured.translation - prediction.pose.translation).norm();
         let information = measurement_information(&registration, self.config.geometric_sigma_m);
         let covariance = covariance_sensor_target(&registration.t_target_sensor, &information)
-            .map(|c| attitude_scaled(&self.config, c, compensated));
+            .map(|c| attitude_scaled(&self.config, mode, c, compensated));
         let mut reasons = quality_issues(&self.config, &registration);
         reasons.extend(inconsistency(
             &self.config.loss,
@@ -267,6 +271,7 @@ impl Tracker {
             points_used,
             timings: Timings::default(),
             fallback: false,
+            start_up: false,
         })
     }
 
