@@ -187,6 +187,7 @@ fn poses_cross_the_zenoh_link_to_the_ground() {
         "spacepose-lidar-sim",
         "spacepose-ingest",
         "spacepose-tracker",
+        "spacepose-init",
         "spacepose-filter",
         "spacepose-telemetry",
     ] {
@@ -335,7 +336,7 @@ fn poses_cross_the_zenoh_link_to_the_ground() {
         "ground tool: {}\nstats a {sa}\nstats b {sb}\nstats ground {sg}",
         String::from_utf8_lossy(&out.stderr)
     );
-    // 30 frames; the first is the truth acquisition's, tracking follows.
+    // 30 frames; init acquires on b from a's clouds, tracking follows.
     assert!(
         tracking >= 20,
         "{tracking} tracking poses at the ground\n{context}"

@@ -11,8 +11,10 @@ use rand_chacha::ChaCha8Rng;
 use spacepose_bus::Bus;
 use spacepose_e2e::*;
 use spacepose_geometry::Point;
+use spacepose_geometry::{Pose, so3};
 use spacepose_messages::{
-    AcquisitionMethod, AcquisitionResult, CloudHeader, MAX_POINTS, Names, PoseEstimate, WireStatus,
+    AcquisitionMethod, AcquisitionResult, CloudHeader, MAX_POINTS, Names, PoseEstimate, TruthMsg,
+    WireStatus,
 };
 use std::collections::BTreeMap;
 use std::process::{Child, Command, Stdio};
@@ -68,6 +70,7 @@ fn the_suite_acquires_at_start_detects_the_loss_and_reacquires() {
     let results = bus
         .subscriber::<AcquisitionResult>(&names.acquisition())
         .unwrap();
+    let truths = bus.subscriber::<TruthMsg>(&names.truth()).unwrap();
     let started = Instant::now();
     let up = spacepose(&[
         "up",
@@ -81,6 +84,7 @@ fn the_suite_acquires_at_start_detects_the_loss_and_reacquires() {
 
     let mut seen: BTreeMap<u64, (PoseEstimate, f64)> = BTreeMap::new();
     let mut acquisitions: Vec<(AcquisitionResult, f64)> = Vec::new();
+    let mut truth: BTreeMap<u64, TruthMsg> = BTreeMap::new();
     let deadline = Instant::now() + Duration::from_secs(120);
     while !seen.contains_key(&(FRAMES - 1)) {
         while let Some(p) = poses.try_recv().unwrap() {
@@ -89,6 +93,9 @@ fn the_suite_acquires_at_start_detects_the_loss_and_reacquires() {
         }
         while let Some(a) = results.try_recv().unwrap() {
             acquisitions.push((a, started.elapsed().as_secs_f64()));
+        }
+        while let Some(t) = truths.try_recv().unwrap() {
+            truth.insert(t.sequence, t);
         }
         assert!(
             Instant::now() < deadline,
@@ -206,6 +213,40 @@ fn the_suite_acquires_at_start_detects_the_loss_and_reacquires() {
         tracked_again >= 3,
         "{tracked_again} tracked frames after the reacquisition"
     );
+    // 4. Scored against the truth (only here, after the run): both
+    //    acquisitions and every pose published `tracking` after them are
+    //    right, up to deos's ±120° symmetry (d_sym, seed 004 Eq. 14).
+    let error = |sequence: u64, pose: Pose| {
+        let t = truth
+            .get(&sequence)
+            .unwrap_or_else(|| panic!("no truth for frame {sequence}"))
+            .pose()
+            .unwrap();
+        let group = spacepose_model::builtin::deos::symmetries();
+        let ang = so3::distance_sym(&pose.rotation, &t.rotation, &group).to_degrees();
+        (ang, (pose.translation - t.translation).norm())
+    };
+    for a in [first, again] {
+        let (ang, pos) = error(a.sequence, a.pose().unwrap());
+        println!(
+            "acquisition of frame {}: {ang:.2} deg, {pos:.3} m from the truth",
+            a.sequence
+        );
+        assert!(
+            ang < 10.0 && pos < 0.3,
+            "acquisition of frame {}: {ang:.2} deg, {pos:.3} m",
+            a.sequence
+        );
+    }
+    for (k, (p, _)) in seen.range(first.sequence..) {
+        if status(p) == WireStatus::Tracking {
+            let (ang, pos) = error(*k, p.pose().unwrap());
+            assert!(
+                ang < 10.0 && pos < 0.5,
+                "frame {k} published tracking {ang:.2} deg, {pos:.3} m off"
+            );
+        }
+    }
     let times: Vec<f64> = acquisitions.iter().map(|(a, _)| a.time_ms).collect();
     println!(
         "acquisition attempts: {}, time per attempt (ms) {:?}",

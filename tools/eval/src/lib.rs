@@ -15,6 +15,7 @@ pub mod cnn;
 pub mod common;
 pub mod dataset;
 pub mod plot;
+pub mod seeds;
 pub mod sim;
 pub mod stats;
 pub mod table;

@@ -75,6 +75,26 @@ pub(crate) struct Dispatch<'a> {
     pub(crate) mode: TrackingMode,
     /// From [`ndt_params`].
     pub(crate) ndt: NdtParams,
+    /// In the start-up (`crate::start_up`), the angular velocity (target
+    /// frame, rad/s) of the last scan CT-NDT fitted, which guesses the end
+    /// of this scan better than the filter's rate, still unknown.
+    pub(crate) start_up_w_target: Option<nalgebra::Vector3<f64>>,
+}
+
+/// What a registration found: the pose, and for a scan CT-NDT fitted with
+/// two poses, `t_target_sensor` at the scan start.
+pub(crate) struct Fitted {
+    pub(crate) registration: Registration,
+    pub(crate) t_target_sensor_start: Option<Pose>,
+}
+
+impl From<Registration> for Fitted {
+    fn from(registration: Registration) -> Self {
+        Self {
+            registration,
+            t_target_sensor_start: None,
+        }
+    }
 }
 
 impl Dispatch<'_> {
@@ -87,7 +107,7 @@ impl Dispatch<'_> {
         prediction: &Prediction,
         last: &LastPose,
         scan: &ScanTimes,
-    ) -> Result<Registration, TrackError> {
+    ) -> Result<Fitted, TrackError> {
         let previous = last.t_sensor_target.inverse();
         let predicted = prediction.pose.inverse();
         let (map, c, ndt) = (&self.model.map, self.config, &self.ndt);
@@ -95,7 +115,9 @@ impl Dispatch<'_> {
             // A held rotation is moved from the guess (the previous pose)
             // to the prediction, as in `icp` mode: where no rate has been
             // fitted it would otherwise stand still.
-            TrackingMode::Ndt => held_at(register_ndt(map, cloud, &previous, ndt)?, &predicted),
+            TrackingMode::Ndt => {
+                held_at(register_ndt(map, cloud, &previous, ndt)?, &predicted).into()
+            }
             // ICP holds a rotation the surface leaves free without saying
             // so. It is held at the prediction instead, as `deblur` holds
             // it, and reported as NDT reports it, so that the hold follows
@@ -104,22 +126,48 @@ impl Dispatch<'_> {
             // seed 7: from frame 1320 at 4.5 m, 1°/s, lost).
             TrackingMode::Icp => {
                 let r = register_icp(self.model.icp()?, cloud, &previous, &c.icp)?;
-                hold_weak_rotations(map, cloud, &predicted, r, ndt)
+                hold_weak_rotations(map, cloud, &predicted, r, ndt).into()
             }
-            TrackingMode::Deblur => register_ndt(map, cloud, &predicted, ndt)?,
+            TrackingMode::Deblur => register_ndt(map, cloud, &predicted, ndt)?.into(),
             // A sparse frame, compensated by the prediction: one pose.
-            TrackingMode::CtNdt if compensated => register_ndt(map, cloud, &predicted, ndt)?,
+            TrackingMode::CtNdt if compensated => register_ndt(map, cloud, &predicted, ndt)?.into(),
             TrackingMode::CtNdt => match c.ct_start {
                 CtStart::Fixed => {
                     let start = self.fixed_ct_start(last, scan.start_s)?;
-                    register_ct_ndt(map, cloud, scan, &start, &predicted, ndt)?
+                    Fitted {
+                        registration: register_ct_ndt(map, cloud, scan, &start, &predicted, ndt)?,
+                        t_target_sensor_start: Some(start),
+                    }
                 }
                 CtStart::FilterPrior => {
                     let priors = self.ct_priors(prediction, scan)?;
-                    register_ct_ndt_with_priors(map, cloud, scan, &priors, &predicted, ndt)?.end
+                    let guess = self.start_up_guess(scan)?.unwrap_or(predicted);
+                    let r = register_ct_ndt_with_priors(map, cloud, scan, &priors, &guess, ndt)?;
+                    Fitted {
+                        registration: r.end,
+                        t_target_sensor_start: Some(r.t_target_sensor_start),
+                    }
                 }
             },
         })
+    }
+
+    /// In the start-up, the end of the scan guessed from the filter's pose
+    /// at its start turned by the last CT-NDT scan's rate
+    /// (`start_up_w_target`): `R(t_s) Exp(ω Δt)`, the filter's position
+    /// (as `t_target_sensor`). `None` outside the start-up.
+    fn start_up_guess(&self, scan: &ScanTimes) -> Result<Option<Pose>, TrackError> {
+        let Some(w) = self.start_up_w_target else {
+            return Ok(None);
+        };
+        let at_start = self.filter.predict_at(scan.start_s)?;
+        let at_end = self.filter.predict_at(scan.end_s)?;
+        let turn = spacepose_geometry::so3::exp(&(w * (scan.end_s - scan.start_s)));
+        let t_sensor_target = Pose {
+            rotation: at_start.pose.rotation * turn,
+            translation: at_end.pose.translation,
+        };
+        Ok(Some(t_sensor_target.inverse()))
     }
 
     /// `T^s` of Eq. (14): the previous result (seed 000 §3.3), carried to

@@ -60,7 +60,7 @@ pub struct TrackOutput {
     pub fallback: bool,
     /// `deblur` mode: fitted as `ct-ndt` fits it, the filter's angular rate
     /// being still too uncertain to compensate the scan
-    /// ([`crate::TrackerConfig::deblur_start_up_blur_deg`]).
+    /// ([`crate::TrackerConfig::start_up_blur_deg`]).
     pub start_up: bool,
 }
 

@@ -111,7 +111,7 @@ fn run_outputs(
 /// first frame, without the start-up by CT-NDT.
 fn paper_deblur() -> TrackerConfig {
     TrackerConfig {
-        deblur_start_up_blur_deg: 0.0,
+        start_up_blur_deg: 0.0,
         ..TrackerConfig::with_mode(TrackingMode::Deblur)
     }
 }
@@ -158,6 +158,7 @@ fn sparse_ct_ndt_frames_fit_one_compensated_pose() {
     let ct = TrackerConfig {
         ct_ndt_motion_prior_weight: 0.0,
         ct_ndt_attitude_covariance_scale: 30.0,
+        start_up_blur_deg: 0.0,
         ..TrackerConfig::with_mode(TrackingMode::CtNdt)
     };
     let sparse_ct = TrackerConfig {
@@ -195,7 +196,11 @@ fn sparse_ct_ndt_frames_fit_one_compensated_pose() {
 /// end-pose Hessian against NDT's) and drift apart a little during warm-up.
 #[test]
 fn a_firm_motion_prior_makes_ct_ndt_follow_deblur() {
-    let ct = TrackerConfig::with_mode(TrackingMode::CtNdt);
+    // Both from the first frame as the paper runs them (no start-up).
+    let ct = TrackerConfig {
+        start_up_blur_deg: 0.0,
+        ..TrackerConfig::with_mode(TrackingMode::CtNdt)
+    };
     let firm = TrackerConfig {
         ct_ndt_motion_prior_weight: 1e6,
         ..ct.clone()
@@ -241,7 +246,7 @@ fn a_stalled_ct_ndt_frame_is_fitted_as_deblur_fits_it() {
         c.loss.max_final_increment_m = 1e-9;
         c.ct_ndt_stall_fallback = fallback;
         // deblur as the paper computes it, from the first frame.
-        c.deblur_start_up_blur_deg = 0.0;
+        c.start_up_blur_deg = 0.0;
         c
     };
     let configs = [
@@ -290,7 +295,7 @@ fn icp_mode_reports_the_rotation_the_surface_leaves_free() {
     }
 }
 
-/// `deblur`'s start-up (`TrackerConfig::deblur_start_up_blur_deg`): from
+/// `deblur`'s start-up (`TrackerConfig::start_up_blur_deg`): from
 /// the truth with ω = 0 on a 10°/s tumble, the first frames are fitted by
 /// CT-NDT (flagged, and only at the start) until the filter's rate is known,
 /// and the whole run stays within 5°, where the paper's `deblur` (off)
@@ -299,7 +304,7 @@ fn icp_mode_reports_the_rotation_the_surface_leaves_free() {
 fn deblur_starts_up_with_ct_ndt_until_the_rate_is_known() {
     let on = TrackerConfig::with_mode(TrackingMode::Deblur);
     let off = TrackerConfig {
-        deblur_start_up_blur_deg: 0.0,
+        start_up_blur_deg: 0.0,
         ..on.clone()
     };
     let results = run_outputs(ScenarioKind::Tumbling, &[on, off], 0, 8, 12);

@@ -6,6 +6,7 @@
 //! committed table differs from what the committed runs give (a unit test
 //! runs the check).
 
+pub mod monte_carlo;
 pub mod runs;
 
 use anyhow::{Context, Result, bail};
@@ -32,7 +33,8 @@ pub const FRAME_PATH_BEFORE_RUNS: &str = "docs/results/frame-path-before";
 pub const TARGET_RUNS: &str = "docs/results/targets";
 
 /// `(file, block name)` of every generated table.
-pub const BLOCKS: [(&str, &str); 4] = [
+pub const BLOCKS: [(&str, &str); 5] = [
+    ("docs/results.md", "monte-carlo"),
     ("README.md", "headline"),
     ("docs/results.md", "tracking-blind"),
     ("docs/design/frame-path.md", "frame-path"),
@@ -60,10 +62,12 @@ pub fn update(root: &Path, write: bool) -> Result<Vec<String>> {
     let blind = pool(&load_dir(&root.join(BLIND_RUNS))?);
     let before = pool(&load_dir(&root.join(FRAME_PATH_BEFORE_RUNS))?);
     let targets = pool_by(&load_dir(&root.join(TARGET_RUNS))?, |r| r.target.clone());
+    let reports = monte_carlo::load(&root.join(monte_carlo::MONTE_CARLO_RUNS))?;
     let mut stale = Vec::new();
     for (file, name) in BLOCKS {
         let body = match name {
-            "headline" => headline(&blind),
+            "monte-carlo" => monte_carlo::table(&reports),
+            "headline" => monte_carlo::headline(&reports),
             "tracking-blind" => full(&blind),
             "targets" => by_target(&targets),
             _ => comparison(&before, &blind),
@@ -103,30 +107,10 @@ fn seeds_line(pools: &Pools) -> String {
     let p = pools.values().flat_map(|m| m.values()).next();
     let (seeds, frames) = p.map_or((0, 0), |p| (p.seeds, p.frames));
     format!(
-        "{seeds} blind seeds, {frames} frames per scenario and mode after the warm-up; \
-         errors pooled over every frame\n\n"
+        "{seeds} seeds (2001-2005: blind when measured, development since; measured before \
+         the start-up), {frames} frames per scenario and mode after the warm-up; errors \
+         pooled over every frame\n\n"
     )
-}
-
-/// The README's table: p95 and max per scenario and mode.
-fn headline(pools: &Pools) -> String {
-    let mut out = seeds_line(pools);
-    out.push_str("| scenario | mode | angle p95 / max (°) | position p95 / max (cm) | diverged frames | of them published as tracking |\n");
-    out.push_str("|---|---|---|---|---|---|\n");
-    for (scenario, modes) in pools {
-        for (mode, p) in modes {
-            out.push_str(&format!(
-                "| {scenario} | {mode} | {} / {} | {} / {} | {} | {} |\n",
-                fmt(p.ang_deg[1], 2),
-                fmt(p.ang_deg[2], 2),
-                fmt(p.pos_cm[1], 1),
-                fmt(p.pos_cm[2], 1),
-                p.diverged,
-                p.silent
-            ));
-        }
-    }
-    out
 }
 
 /// The cells every pooled row shares: angle and position p50 / p95 / max,
@@ -168,8 +152,9 @@ fn by_target(pools: &Pools) -> String {
     let p = pools.values().flat_map(|m| m.values()).next();
     let (seeds, frames) = p.map_or((0, 0), |p| (p.seeds, p.frames));
     let mut out = format!(
-        "tumbling, {seeds} blind seeds, {frames} frames per target and mode after the warm-up; \
-         errors pooled over every frame\n\n"
+        "tumbling, {seeds} seeds (2001-2005: blind when measured, development since; \
+         measured before the start-up), {frames} frames per target and mode after the \
+         warm-up; errors pooled over every frame\n\n"
     );
     out.push_str("| target | mode | angle p50 / p95 / max (°) | position p50 / p95 / max (cm) | lost | diverged | silent |\n");
     out.push_str("|---|---|---|---|---|---|---|\n");

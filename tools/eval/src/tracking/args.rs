@@ -93,6 +93,16 @@ pub struct EvalTrackingArgs {
     /// Write the results as JSON.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Monte-Carlo over the seeds of `--seeds` instead of one run (`--seed`
+    /// is then ignored): per-seed figures with the start-up included, and
+    /// their mean, p95, max and 95 % confidence interval, as JSON in this
+    /// file
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// The seeds of `--report`: `blind` or `development` (the lists of
+    /// tools/eval/seeds.toml), or seeds separated by commas
+    #[arg(long, default_value = "blind")]
+    pub seeds: String,
     /// Draw the errors over time (.png or .svg), like seed 000 Fig. 9/11.
     #[arg(long)]
     pub plot: Option<PathBuf>,

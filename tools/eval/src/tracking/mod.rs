@@ -24,6 +24,7 @@
 mod args;
 pub mod deployed;
 pub mod frames;
+pub mod monte_carlo;
 mod plot;
 mod render;
 pub mod report;
@@ -299,6 +300,9 @@ impl Tracked {
 /// Runs the command.
 pub fn run(args: &EvalTrackingArgs) -> Result<()> {
     let config = eval_config(args)?;
+    if let Some(path) = &args.report {
+        return run_report(args, &config, path);
+    }
     let report = evaluate(&config)?;
     print!("{}", render::render(&report));
     if let Some(path) = &args.json {
@@ -307,6 +311,21 @@ pub fn run(args: &EvalTrackingArgs) -> Result<()> {
     if let Some(path) = &args.plot {
         plot::write_plot(path, &report)?;
     }
+    Ok(())
+}
+
+/// `--report`: the Monte-Carlo over `--seeds`, printed and written.
+fn run_report(args: &EvalTrackingArgs, config: &EvalConfig, path: &Path) -> Result<()> {
+    let seeds = crate::seeds::SeedLists::committed()?.scenario_seeds(&args.seeds)?;
+    let configuration = args.tracker_config.as_ref().map_or_else(
+        || "defaults".to_string(),
+        |p| format!("tracker config {}", p.display()),
+    );
+    let report = monte_carlo::monte_carlo(config, &args.seeds, &seeds, &configuration)?;
+    print!("{}", render::render_monte_carlo(&report));
+    let text = serde_json::to_string_pretty(&report).context("serialising the report")?;
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;
+    println!("report written to {}", path.display());
     Ok(())
 }
 

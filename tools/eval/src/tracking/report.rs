@@ -70,7 +70,7 @@ pub struct FrameRecord {
     /// fits it (`TrackerConfig::ct_ndt_stall_fallback`).
     pub fallback: bool,
     /// `deblur` mode: fitted by CT-NDT in the start-up
-    /// (`TrackerConfig::deblur_start_up_blur_deg`).
+    /// (`TrackerConfig::start_up_blur_deg`).
     pub start_up: bool,
 }
 

@@ -8,7 +8,7 @@ use crate::mode::TrackingMode;
 use crate::pipeline::Prepared;
 use crate::start_up::frame_mode;
 use spacepose_filter::Prediction;
-use spacepose_geometry::Point;
+use spacepose_geometry::{Point, Pose};
 use spacepose_registration::{Registration, ScanTimes};
 use std::time::Instant;
 
@@ -23,6 +23,9 @@ pub(super) struct Measured {
     pub(super) fallback: bool,
     /// The frame's registration (`crate::start_up::frame_mode`).
     pub(super) mode: TrackingMode,
+    /// `t_target_sensor` at the scan start, when CT-NDT fitted the scan
+    /// with two poses.
+    pub(super) t_target_sensor_start: Option<Pose>,
     pub(super) preprocess_ms: f64,
     /// Registration, the fallback included.
     pub(super) registration_ms: f64,
@@ -84,10 +87,11 @@ impl Tracker {
             });
         }
         let reg_start = Instant::now();
-        let registration = self
-            .dispatch(mode)
+        let fitted = self
+            .dispatch(mode, prediction, scan)
             .register(&cloud, compensated, prediction, last, scan)
             .map_err(|e| Missing::because(e.to_string()))?;
+        let (registration, start) = (fitted.registration, fitted.t_target_sensor_start);
         let fallback = self.stall_fallback(
             points,
             &registration,
@@ -96,9 +100,9 @@ impl Tracker {
             last,
             scan,
         );
-        let (registration, compensated, points_used, fallback) = match fallback {
-            Some((r, n)) => (r, true, n, true),
-            None => (registration, compensated, cloud.len(), false),
+        let (registration, compensated, points_used, fallback, start) = match fallback {
+            Some((r, n)) => (r, true, n, true, None),
+            None => (registration, compensated, cloud.len(), false, start),
         };
         Ok(Measured {
             registration,
@@ -106,6 +110,7 @@ impl Tracker {
             points_used,
             fallback,
             mode,
+            t_target_sensor_start: start,
             preprocess_ms,
             registration_ms: ms(reg_start),
         })
@@ -134,10 +139,11 @@ impl Tracker {
         }
         let cloud = self.pipeline.compensated(points, prediction).ok()?;
         match self
-            .dispatch(mode)
+            .dispatch(mode, prediction, scan)
             .register(&cloud, true, prediction, last, scan)
         {
             Ok(r) => {
+                let r = r.registration;
                 tracing::debug!(
                     t = scan.end_s,
                     iterations = registration.iterations,

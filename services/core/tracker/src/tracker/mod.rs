@@ -37,6 +37,10 @@ pub struct Tracker {
     holding: bool,
     /// The track's recent poses and the rate a held rotation follows.
     held: HeldRotation,
+    /// The angular velocity (target frame, rad/s) over the last scan that
+    /// CT-NDT fitted with two poses and was tracked; reset at each
+    /// (re)initialisation (`crate::start_up`).
+    scan_w_target: Option<Vector3<f64>>,
 }
 
 impl Tracker {
@@ -62,6 +66,7 @@ impl Tracker {
             consecutive_degraded: 0,
             holding: false,
             held,
+            scan_w_target: None,
         })
     }
 
@@ -127,6 +132,7 @@ impl Tracker {
         self.consecutive_degraded = 0;
         self.holding = false;
         self.held.reset();
+        self.scan_w_target = None;
         Ok(())
     }
 
@@ -176,12 +182,16 @@ impl Tracker {
             }
         };
         self.holding = m.registration.degenerate_directions > 0;
+        let scan_w = scan_rate(m.t_target_sensor_start.as_ref(), &m.registration, &scan);
         let registration = self.held.follow(scan_end, m.registration);
         let counts = (points.len(), m.points_used);
         let fitted = (m.mode, m.compensated);
         let mut out = self.assess(registration, fitted, &prediction, scan_end, counts)?;
         out.fallback = m.fallback;
         out.start_up = m.mode != self.config.mode;
+        if out.status == TrackStatus::Tracking && scan_w.is_some() {
+            self.scan_w_target = scan_w;
+        }
         self.record_tracked(&out);
         out.timings = Timings {
             preprocess_ms: m.preprocess_ms,
@@ -207,14 +217,27 @@ impl Tracker {
     /// The registration of `mode` (the frame's: `crate::start_up`), with the
     /// degeneracy handling's threshold in force (hysteresis while a
     /// rotation is held).
-    pub(crate) fn dispatch(&self, mode: TrackingMode) -> Dispatch<'_> {
+    pub(crate) fn dispatch(
+        &self,
+        mode: TrackingMode,
+        prediction: &Prediction,
+        scan: &ScanTimes,
+    ) -> Dispatch<'_> {
         let following = self.held.following().then(|| self.held.min_lever_arm_m());
+        let start_up = self.config.mode.uses_prediction()
+            && crate::start_up::rate_unknown(&self.config, prediction, scan);
+        let start_up_w_target = self.scan_w_target.filter(|_| start_up);
+        let mut ndt = ndt_params(&self.config, self.holding, following);
+        if start_up {
+            ndt.max_iterations = ndt.max_iterations.max(self.config.start_up_max_iterations);
+        }
         Dispatch {
+            start_up_w_target,
             config: &self.config,
             model: &self.model,
             filter: &self.filter,
             mode,
-            ndt: ndt_params(&self.config, self.holding, following),
+            ndt,
         }
     }
 
@@ -305,6 +328,19 @@ impl Tracker {
         self.lost = true;
         TrackOutput::lost(prediction, points_in, &reason, started)
     }
+}
+
+/// The angular velocity (target frame, rad/s) over a scan fitted with two
+/// poses: `Log(R_sᵀ R_e) / Δt` of `t_sensor_target` at its start and end.
+fn scan_rate(
+    t_target_sensor_start: Option<&Pose>,
+    registration: &Registration,
+    scan: &ScanTimes,
+) -> Option<Vector3<f64>> {
+    let start = t_target_sensor_start?.inverse();
+    let end = registration.t_sensor_target();
+    let dt = scan.end_s - scan.start_s;
+    (dt > 0.0).then(|| so3::log(&(start.rotation.inverse() * end.rotation)) / dt)
 }
 
 pub(crate) fn ms(since: Instant) -> f64 {
