@@ -282,7 +282,7 @@ fn demo_on_a_generated_target_needs_no_descriptor() {
 /// The same goals with the test-facility background that ingest must crop
 /// (deploy/examples/demo-clutter.toml).
 #[test]
-#[ignore = "fails: with the facility clutter on, ingest's crop keeps part of the robot arm; the registration diverges around frame 8 (13-14° error, seed 7) and the track is lost a few frames later"]
+#[ignore = "fails: with the facility clutter on and no truth, init never accepts a pose (20 frames, seed 7): before the first acquisition ingest has no filter state to crop around and forwards the whole 54,000-point frame with the facility; the CNN gives a non-finite output and template matching rejects (f_CONV 3.9e-2 m2). Issue 25 item 6"]
 fn demo_with_clutter_meets_the_tracking_goals() {
     let (s, all) = demo_summary(
         "clutter",

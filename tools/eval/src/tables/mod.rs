@@ -8,6 +8,7 @@
 
 pub mod monte_carlo;
 pub mod runs;
+pub mod zoo;
 
 use anyhow::{Context, Result, bail};
 use runs::{Pooled, Pools, load_dir, pool, pool_by};
@@ -33,7 +34,8 @@ pub const FRAME_PATH_BEFORE_RUNS: &str = "docs/results/frame-path-before";
 pub const TARGET_RUNS: &str = "docs/results/targets";
 
 /// `(file, block name)` of every generated table.
-pub const BLOCKS: [(&str, &str); 5] = [
+pub const BLOCKS: [(&str, &str); 6] = [
+    ("docs/design/target-packages.md", "zoo-tracking"),
     ("docs/results.md", "monte-carlo"),
     ("README.md", "headline"),
     ("docs/results.md", "tracking-blind"),
@@ -63,10 +65,12 @@ pub fn update(root: &Path, write: bool) -> Result<Vec<String>> {
     let before = pool(&load_dir(&root.join(FRAME_PATH_BEFORE_RUNS))?);
     let targets = pool_by(&load_dir(&root.join(TARGET_RUNS))?, |r| r.target.clone());
     let reports = monte_carlo::load(&root.join(monte_carlo::MONTE_CARLO_RUNS))?;
+    let zoo_runs = load_dir(&root.join(zoo::ZOO_TRACKING_RUNS))?;
     let mut stale = Vec::new();
     for (file, name) in BLOCKS {
         let body = match name {
             "monte-carlo" => monte_carlo::table(&reports),
+            "zoo-tracking" => zoo::table(&zoo_runs),
             "headline" => monte_carlo::headline(&reports),
             "tracking-blind" => full(&blind),
             "targets" => by_target(&targets),

@@ -6,21 +6,25 @@ use spacepose_tracker::{CtStart, TrackingMode};
 use std::path::PathBuf;
 use std::str::FromStr;
 
-/// `--mode`: one tracking mode, or `all` of them on the same frames.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// `--mode`: one tracking mode, several separated by commas, or `all` of
+/// them, on the same frames.
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Modes {
     /// Every mode, in the order of seed 000's tables.
     All,
     /// One mode.
     One(TrackingMode),
+    /// Several modes, in the order given.
+    Some(Vec<TrackingMode>),
 }
 
 impl Modes {
     /// The modes selected.
-    pub fn list(self) -> Vec<TrackingMode> {
+    pub fn list(&self) -> Vec<TrackingMode> {
         match self {
             Modes::All => TrackingMode::ALL.to_vec(),
-            Modes::One(m) => vec![m],
+            Modes::One(m) => vec![*m],
+            Modes::Some(v) => v.clone(),
         }
     }
 }
@@ -32,6 +36,13 @@ impl FromStr for Modes {
         if s == "all" {
             return Ok(Modes::All);
         }
+        if s.contains(',') {
+            return s
+                .split(',')
+                .map(|m| m.trim().parse::<TrackingMode>())
+                .collect::<Result<Vec<_>, _>>()
+                .map(Modes::Some);
+        }
         s.parse().map(Modes::One)
     }
 }
@@ -42,7 +53,8 @@ pub struct EvalTrackingArgs {
     /// Scenario (slow-spin or tumbling).
     #[arg(long, default_value = "tumbling")]
     pub scenario: ScenarioKind,
-    /// Tracking mode, or all of them on the same frames.
+    /// Tracking mode, several separated by commas, or all of them, on the
+    /// same frames.
     #[arg(long, default_value = "all")]
     pub mode: Modes,
     /// Frames to run; default: the whole scenario at 1 Hz.
@@ -120,6 +132,11 @@ mod tests {
             Ok(Modes::One(TrackingMode::CtNdt))
         );
         assert!("gicp".parse::<Modes>().is_err());
+        assert_eq!(
+            "deblur, ct-ndt".parse::<Modes>(),
+            Ok(Modes::Some(vec![TrackingMode::Deblur, TrackingMode::CtNdt]))
+        );
+        assert!("deblur,gicp".parse::<Modes>().is_err());
         assert_eq!(Modes::All.list(), TrackingMode::ALL.to_vec());
     }
 }
