@@ -321,7 +321,13 @@ fn run_report(args: &EvalTrackingArgs, config: &EvalConfig, path: &Path) -> Resu
         || "defaults".to_string(),
         |p| format!("tracker config {}", p.display()),
     );
-    let report = monte_carlo::monte_carlo(config, &args.seeds, &seeds, &configuration)?;
+    let evaluate_seed = |seed| {
+        evaluate(&EvalConfig {
+            seed,
+            ..config.clone()
+        })
+    };
+    let report = monte_carlo::monte_carlo(evaluate_seed, &args.seeds, &seeds, &configuration)?;
     print!("{}", render::render_monte_carlo(&report));
     let text = serde_json::to_string_pretty(&report).context("serialising the report")?;
     std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?;

@@ -8,7 +8,6 @@
 //! `crate::tables::monte_carlo` reads the files back.
 
 use super::report::{DIVERGED_DEG, DIVERGED_M, FrameRecord, TrackingReport};
-use super::{EvalConfig, evaluate};
 use anyhow::Result;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -84,10 +83,11 @@ pub struct MonteCarloReport {
     pub modes: BTreeMap<String, ModeMonteCarlo>,
 }
 
-/// Runs `config` on every seed of `seeds` (two at a time on this machine's
-/// cores; each run's frames are simulated in parallel too).
+/// Runs `evaluate` (one evaluation of a seed) on every seed of `seeds`
+/// (two at a time on this machine's cores; each run's frames are simulated
+/// in parallel too) and reduces the runs.
 pub fn monte_carlo(
-    config: &EvalConfig,
+    evaluate: impl Fn(u64) -> Result<TrackingReport> + Sync,
     seed_set: &str,
     seeds: &[u64],
     configuration: &str,
@@ -95,14 +95,12 @@ pub fn monte_carlo(
     let runs: Vec<TrackingReport> = seeds
         .par_iter()
         .map(|&seed| {
-            let run = evaluate(&EvalConfig {
-                seed,
-                ..config.clone()
-            });
+            let run = evaluate(seed);
             tracing::info!(seed, ok = run.is_ok(), "Monte-Carlo run done");
             run
         })
         .collect::<Result<_>>()?;
+    anyhow::ensure!(!runs.is_empty(), "no seed to run");
     let first = &runs[0];
     let mut modes = BTreeMap::new();
     for mode in first.modes.keys() {
