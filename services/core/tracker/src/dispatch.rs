@@ -71,7 +71,7 @@ pub(crate) struct Dispatch<'a> {
     pub(crate) model: &'a TrackingModel,
     pub(crate) filter: &'a RelativeMotionFilter,
     /// The frame's registration: the configured mode's, or `ct-ndt`'s in
-    /// `deblur`'s start-up (`crate::start_up::frame_mode`).
+    /// `deblur`'s start-up (`crate::start_up::frame_plan`).
     pub(crate) mode: TrackingMode,
     /// From [`ndt_params`].
     pub(crate) ndt: NdtParams,
@@ -141,7 +141,9 @@ impl Dispatch<'_> {
                 }
                 CtStart::FilterPrior => {
                     let priors = self.ct_priors(prediction, scan)?;
-                    let guess = self.start_up_guess(scan)?.unwrap_or(predicted);
+                    let guess = self
+                        .start_up_guess(&priors, prediction, scan)
+                        .unwrap_or(predicted);
                     let r = register_ct_ndt_with_priors(map, cloud, scan, &priors, &guess, ndt)?;
                     Fitted {
                         registration: r.end,
@@ -153,21 +155,24 @@ impl Dispatch<'_> {
     }
 
     /// In the start-up, the end of the scan guessed from the filter's pose
-    /// at its start turned by the last CT-NDT scan's rate
-    /// (`start_up_w_target`): `R(t_s) Exp(ω Δt)`, the filter's position
-    /// (as `t_target_sensor`). `None` outside the start-up.
-    fn start_up_guess(&self, scan: &ScanTimes) -> Result<Option<Pose>, TrackError> {
-        let Some(w) = self.start_up_w_target else {
-            return Ok(None);
-        };
-        let at_start = self.filter.predict_at(scan.start_s)?;
-        let at_end = self.filter.predict_at(scan.end_s)?;
+    /// at its start (the start prior's mean) turned by the last CT-NDT
+    /// scan's rate (`start_up_w_target`), `R(t_s) Exp(ω Δt)`, at the
+    /// predicted position (as `t_target_sensor`). `None` outside the
+    /// start-up.
+    fn start_up_guess(
+        &self,
+        priors: &CtPriors,
+        at_end: &Prediction,
+        scan: &ScanTimes,
+    ) -> Option<Pose> {
+        let w = self.start_up_w_target?;
+        let start = priors.start.t_target_sensor.inverse();
         let turn = spacepose_geometry::so3::exp(&(w * (scan.end_s - scan.start_s)));
         let t_sensor_target = Pose {
-            rotation: at_start.pose.rotation * turn,
+            rotation: start.rotation * turn,
             translation: at_end.pose.translation,
         };
-        Ok(Some(t_sensor_target.inverse()))
+        Some(t_sensor_target.inverse())
     }
 
     /// `T^s` of Eq. (14): the previous result (seed 000 §3.3), carried to

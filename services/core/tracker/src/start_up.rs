@@ -58,19 +58,30 @@ pub(crate) fn rate_unknown(c: &TrackerConfig, prediction: &Prediction, scan: &Sc
     bound > 0.0 && rate_blur_deg(prediction, scan) > bound
 }
 
-/// The registration a frame gets: the configured mode's, except a `deblur`
-/// frame during the start-up (rate blur above
-/// `start_up_blur_deg`, when that is > 0), which gets `ct-ndt`'s.
-pub(crate) fn frame_mode(
+/// How a frame is fitted, decided once per frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct FramePlan {
+    /// The registration: the configured mode's, except a `deblur` frame in
+    /// the start-up, which gets `ct-ndt`'s.
+    pub(crate) mode: TrackingMode,
+    /// In the start-up: a mode that uses the prediction, and the rate
+    /// unknown ([`rate_unknown`]).
+    pub(crate) start_up: bool,
+}
+
+/// The plan of a frame ending `scan` with the filter at `prediction`.
+pub(crate) fn frame_plan(
     c: &TrackerConfig,
     prediction: &Prediction,
     scan: &ScanTimes,
-) -> TrackingMode {
-    if c.mode == TrackingMode::Deblur && rate_unknown(c, prediction, scan) {
+) -> FramePlan {
+    let start_up = c.mode.uses_prediction() && rate_unknown(c, prediction, scan);
+    let mode = if start_up && c.mode == TrackingMode::Deblur {
         TrackingMode::CtNdt
     } else {
         c.mode
-    }
+    };
+    FramePlan { mode, start_up }
 }
 
 #[cfg(test)]
@@ -113,17 +124,28 @@ mod tests {
         assert!(bound > 0.0);
         let unknown = prediction([30.0; 3]);
         let known = prediction([0.5 * bound / 0.5; 3]);
-        assert_eq!(frame_mode(&c, &unknown, &SCAN), TrackingMode::CtNdt);
-        assert_eq!(frame_mode(&c, &known, &SCAN), TrackingMode::Deblur);
+        let plan = frame_plan(&c, &unknown, &SCAN);
+        assert_eq!((plan.mode, plan.start_up), (TrackingMode::CtNdt, true));
+        let plan = frame_plan(&c, &known, &SCAN);
+        assert_eq!((plan.mode, plan.start_up), (TrackingMode::Deblur, false));
         // Off, and the other modes: their own registration.
         let off = TrackerConfig {
             start_up_blur_deg: 0.0,
             ..c.clone()
         };
-        assert_eq!(frame_mode(&off, &unknown, &SCAN), TrackingMode::Deblur);
-        for mode in [TrackingMode::Ndt, TrackingMode::Icp, TrackingMode::CtNdt] {
-            let c = TrackerConfig::with_mode(mode);
-            assert_eq!(frame_mode(&c, &unknown, &SCAN), mode);
+        let plan = frame_plan(&off, &unknown, &SCAN);
+        assert_eq!((plan.mode, plan.start_up), (TrackingMode::Deblur, false));
+        // ct-ndt keeps its registration and has a start-up; ndt and icp
+        // have none.
+        let ct = frame_plan(
+            &TrackerConfig::with_mode(TrackingMode::CtNdt),
+            &unknown,
+            &SCAN,
+        );
+        assert_eq!((ct.mode, ct.start_up), (TrackingMode::CtNdt, true));
+        for mode in [TrackingMode::Ndt, TrackingMode::Icp] {
+            let plan = frame_plan(&TrackerConfig::with_mode(mode), &unknown, &SCAN);
+            assert_eq!((plan.mode, plan.start_up), (mode, false));
         }
     }
 }

@@ -21,6 +21,14 @@ pub struct FrameErr {
     pub pos_err_cm: Option<f64>,
 }
 
+impl FrameErr {
+    /// More than 10° or 50 cm off in truth, or without a pose.
+    pub fn far_off(&self) -> bool {
+        !(self.ang_err_deg.is_some_and(|a| a <= DIVERGED_DEG)
+            && self.pos_err_cm.is_some_and(|p| p <= DIVERGED_M * 100.0))
+    }
+}
+
 /// One mode of a run.
 #[derive(Debug, Clone, Deserialize)]
 pub struct ModeRun {
@@ -124,11 +132,7 @@ fn pooled(seeds: usize, series: &[FrameErr]) -> Pooled {
         .filter(published)
         .filter_map(|f| f.pos_err_cm)
         .collect();
-    let is_diverged = |f: &FrameErr| {
-        f.status == "lost"
-            || !(f.ang_err_deg.is_some_and(|a| a <= DIVERGED_DEG)
-                && f.pos_err_cm.is_some_and(|p| p <= DIVERGED_M * 100.0))
-    };
+    let is_diverged = |f: &FrameErr| f.status == "lost" || f.far_off();
     Pooled {
         seeds,
         frames: series.len(),

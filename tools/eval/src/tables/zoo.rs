@@ -4,7 +4,6 @@
 //! issue's goal.
 
 use super::runs::{FrameErr, Run};
-use crate::tracking::{DIVERGED_DEG, DIVERGED_M};
 use std::collections::BTreeMap;
 
 /// Committed runs on the generated designs (`docs/results/measure-zoo-tracking.sh`).
@@ -26,11 +25,7 @@ fn max_from(series: &[FrameErr], from: usize) -> f64 {
 fn silent(series: &[FrameErr]) -> usize {
     series
         .iter()
-        .filter(|f| {
-            f.status == "tracking"
-                && !(f.ang_err_deg.is_some_and(|a| a <= DIVERGED_DEG)
-                    && f.pos_err_cm.is_some_and(|p| p <= DIVERGED_M * 100.0))
-        })
+        .filter(|f| f.status == "tracking" && f.far_off())
         .count()
 }
 

@@ -7,7 +7,7 @@
 //! with no value (NaN: no pose at all) is written as `null`;
 //! `crate::tables::monte_carlo` reads the files back.
 
-use super::report::{DIVERGED_DEG, DIVERGED_M, FrameRecord, TrackingReport};
+use super::report::{FrameRecord, TrackingReport};
 use anyhow::Result;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -133,8 +133,6 @@ pub fn figures(seed: u64, series: &[FrameRecord], warmup: usize) -> SeedFigures 
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
     let ang: Vec<f64> = published.iter().map(|r| r.ang_err_deg).collect();
     let pos: Vec<f64> = published.iter().map(|r| r.pos_err_cm).collect();
-    let off =
-        |r: &FrameRecord| !(r.ang_err_deg <= DIVERGED_DEG && r.pos_err_cm <= DIVERGED_M * 100.0);
     let count = |s: TrackStatus| series.iter().filter(|r| r.status == s).count();
     SeedFigures {
         seed,
@@ -150,11 +148,11 @@ pub fn figures(seed: u64, series: &[FrameRecord], warmup: usize) -> SeedFigures 
         degraded: count(TrackStatus::Degraded),
         diverged: series
             .iter()
-            .filter(|r| r.status == TrackStatus::Lost || off(r))
+            .filter(|r| r.status == TrackStatus::Lost || r.far_off())
             .count(),
         silent: series
             .iter()
-            .filter(|r| r.status == TrackStatus::Tracking && off(r))
+            .filter(|r| r.status == TrackStatus::Tracking && r.far_off())
             .count(),
     }
 }

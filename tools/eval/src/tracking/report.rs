@@ -130,6 +130,14 @@ pub struct TrackingReport {
     pub modes: BTreeMap<String, ModeReport>,
 }
 
+impl FrameRecord {
+    /// More than [`DIVERGED_DEG`] or [`DIVERGED_M`] off in truth; a frame
+    /// without a pose (NaN errors) counts.
+    pub fn far_off(&self) -> bool {
+        !(self.ang_err_deg <= DIVERGED_DEG && self.pos_err_cm <= DIVERGED_M * 100.0)
+    }
+}
+
 /// The record of frame `index`: the estimate the tracker published, scored
 /// against the frame's truth, with the registration's figures from its
 /// `TrackOutput` (absent when the cloud never reached the tracker).
@@ -188,10 +196,7 @@ pub fn summarise(series: Vec<FrameRecord>, warmup: usize) -> ModeReport {
         series.iter().skip(skip).map(f).collect()
     };
     let count = |s: TrackStatus| series.iter().filter(|r| r.status == s).count();
-    let diverged = series
-        .iter()
-        .filter(|r| !(r.ang_err_deg <= DIVERGED_DEG && r.pos_err_cm <= DIVERGED_M * 100.0))
-        .count();
+    let diverged = series.iter().filter(|r| r.far_off()).count();
     let times = pick(|r| r.time_ms, 0);
     ModeReport {
         ang_err_deg: MeanMax::of(&pick(|r| r.ang_err_deg, 0)),

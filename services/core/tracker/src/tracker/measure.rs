@@ -6,7 +6,7 @@ use crate::assess::stalled;
 use crate::dispatch::LastPose;
 use crate::mode::TrackingMode;
 use crate::pipeline::Prepared;
-use crate::start_up::frame_mode;
+use crate::start_up::{FramePlan, frame_plan};
 use spacepose_filter::Prediction;
 use spacepose_geometry::{Point, Pose};
 use spacepose_registration::{Registration, ScanTimes};
@@ -21,7 +21,7 @@ pub(super) struct Measured {
     pub(super) points_used: usize,
     /// Fitted by the stall fallback.
     pub(super) fallback: bool,
-    /// The frame's registration (`crate::start_up::frame_mode`).
+    /// The frame's registration (`crate::start_up::frame_plan`).
     pub(super) mode: TrackingMode,
     /// `t_target_sensor` at the scan start, when CT-NDT fitted the scan
     /// with two poses.
@@ -66,7 +66,8 @@ impl Tracker {
     ) -> Result<Measured, Missing> {
         let pre = Instant::now();
         let c = &self.config;
-        let mode = frame_mode(c, prediction, scan);
+        let plan = frame_plan(c, prediction, scan);
+        let mode = plan.mode;
         let Prepared { cloud, compensated } = self
             .pipeline
             .prepare(points, mode, c.ct_ndt_min_points, prediction)
@@ -88,14 +89,14 @@ impl Tracker {
         }
         let reg_start = Instant::now();
         let fitted = self
-            .dispatch(mode, prediction, scan)
+            .dispatch(plan)
             .register(&cloud, compensated, prediction, last, scan)
             .map_err(|e| Missing::because(e.to_string()))?;
         let (registration, start) = (fitted.registration, fitted.t_target_sensor_start);
         let fallback = self.stall_fallback(
             points,
             &registration,
-            (mode, compensated),
+            (plan, compensated),
             prediction,
             last,
             scan,
@@ -124,13 +125,13 @@ impl Tracker {
         &mut self,
         points: &[Point],
         registration: &Registration,
-        (mode, compensated): (TrackingMode, bool),
+        (plan, compensated): (FramePlan, bool),
         prediction: &Prediction,
         last: &LastPose,
         scan: &ScanTimes,
     ) -> Option<(Registration, usize)> {
         let c = &self.config;
-        if mode != TrackingMode::CtNdt
+        if plan.mode != TrackingMode::CtNdt
             || compensated
             || !c.ct_ndt_stall_fallback
             || !stalled(&c.loss, registration)
@@ -139,7 +140,7 @@ impl Tracker {
         }
         let cloud = self.pipeline.compensated(points, prediction).ok()?;
         match self
-            .dispatch(mode, prediction, scan)
+            .dispatch(plan)
             .register(&cloud, true, prediction, last, scan)
         {
             Ok(r) => {

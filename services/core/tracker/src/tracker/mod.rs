@@ -217,26 +217,18 @@ impl Tracker {
     /// The registration of `mode` (the frame's: `crate::start_up`), with the
     /// degeneracy handling's threshold in force (hysteresis while a
     /// rotation is held).
-    pub(crate) fn dispatch(
-        &self,
-        mode: TrackingMode,
-        prediction: &Prediction,
-        scan: &ScanTimes,
-    ) -> Dispatch<'_> {
+    pub(crate) fn dispatch(&self, plan: crate::start_up::FramePlan) -> Dispatch<'_> {
         let following = self.held.following().then(|| self.held.min_lever_arm_m());
-        let start_up = self.config.mode.uses_prediction()
-            && crate::start_up::rate_unknown(&self.config, prediction, scan);
-        let start_up_w_target = self.scan_w_target.filter(|_| start_up);
         let mut ndt = ndt_params(&self.config, self.holding, following);
-        if start_up {
+        if plan.start_up {
             ndt.max_iterations = ndt.max_iterations.max(self.config.start_up_max_iterations);
         }
         Dispatch {
-            start_up_w_target,
+            start_up_w_target: self.scan_w_target.filter(|_| plan.start_up),
             config: &self.config,
             model: &self.model,
             filter: &self.filter,
-            mode,
+            mode: plan.mode,
             ndt,
         }
     }
