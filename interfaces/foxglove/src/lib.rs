@@ -1,0 +1,1 @@
+//! The suite's messages as Foxglove schemas, written to MCAP.
