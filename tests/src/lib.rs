@@ -188,21 +188,27 @@ pub fn scratch_dir(name: &str) -> PathBuf {
 /// Version of the Python zenoh client the tests install.
 pub const PYTHON_ZENOH: &str = "eclipse-zenoh==1.10.2";
 
-/// A Python interpreter with `zenoh` importable: a venv under the target
-/// directory (`target/release/e2e-venv`), created and filled with
-/// [`PYTHON_ZENOH`] on first use. `Err` says why it is not available.
+/// A Python interpreter with `zenoh` importable (see [`python_with`]).
 pub fn python_with_zenoh() -> Result<PathBuf, String> {
-    let venv = bin_dir().join("e2e-venv");
+    python_with("zenoh", &[PYTHON_ZENOH], "import zenoh")
+}
+
+/// A Python interpreter of a venv under the target directory
+/// (`target/release/e2e-venv-<name>`), created and filled with the pinned
+/// `packages` on first use; `check` is Python code that must run in it
+/// (an import). `Err` says why it is not available.
+pub fn python_with(name: &str, packages: &[&str], check: &str) -> Result<PathBuf, String> {
+    let venv = bin_dir().join(format!("e2e-venv-{name}"));
     let python = venv.join("bin").join("python");
-    let has_zenoh = |py: &Path| {
+    let usable = |py: &Path| {
         Command::new(py)
-            .args(["-c", "import zenoh"])
+            .args(["-c", check])
             .stdout(Stdio::null())
             .stderr(Stdio::null())
             .status()
             .is_ok_and(|s| s.success())
     };
-    if python.is_file() && has_zenoh(&python) {
+    if python.is_file() && usable(&python) {
         return Ok(python);
     }
     let run = |cmd: &mut Command, what: &str| -> Result<(), String> {
@@ -223,18 +229,13 @@ pub fn python_with_zenoh() -> Result<PathBuf, String> {
         Command::new("python3").args(["-m", "venv"]).arg(&venv),
         "python3 -m venv",
     )?;
-    run(
-        Command::new(venv.join("bin").join("pip")).args([
-            "install",
-            "--quiet",
-            "--disable-pip-version-check",
-            PYTHON_ZENOH,
-        ]),
-        &format!("pip install {PYTHON_ZENOH}"),
-    )?;
-    if has_zenoh(&python) {
+    let mut pip = Command::new(venv.join("bin").join("pip"));
+    pip.args(["install", "--quiet", "--disable-pip-version-check"])
+        .args(packages);
+    run(&mut pip, &format!("pip install {}", packages.join(" ")))?;
+    if usable(&python) {
         Ok(python)
     } else {
-        Err("zenoh is not importable after the installation".to_string())
+        Err(format!("`{check}` fails after installing {}", packages.join(" ")))
     }
 }
