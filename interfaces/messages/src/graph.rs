@@ -32,6 +32,9 @@ pub enum ServiceKind {
     /// by `spacepose up --host` to each host's part of a partitioned
     /// deployment, never written in a descriptor.
     Bridge,
+    /// The run into an MCAP file with Foxglove schemas (`spacepose-recorder`);
+    /// added by `spacepose demo --record` and `spacepose up --record`.
+    Recorder,
 }
 
 /// Whether a service can do its job without an input.
@@ -47,7 +50,7 @@ use Need::{Optional, Required};
 
 impl ServiceKind {
     /// Every kind.
-    pub const ALL: [ServiceKind; 8] = [
+    pub const ALL: [ServiceKind; 9] = [
         ServiceKind::LidarSim,
         ServiceKind::PcdReplay,
         ServiceKind::Ingest,
@@ -56,6 +59,7 @@ impl ServiceKind {
         ServiceKind::Telemetry,
         ServiceKind::Init,
         ServiceKind::Bridge,
+        ServiceKind::Recorder,
     ];
 
     /// The descriptor spelling (`"lidar-sim"`, ...), also the service name
@@ -70,6 +74,7 @@ impl ServiceKind {
             ServiceKind::Telemetry => "telemetry",
             ServiceKind::Init => "init",
             ServiceKind::Bridge => "bridge",
+            ServiceKind::Recorder => "recorder",
         }
     }
 
@@ -131,6 +136,16 @@ impl ServiceKind {
             ServiceKind::Init => &[(Topic::Pose, Optional), (Topic::Cloud, Required)],
             // Its routes are in its config (`spacepose up` plans them).
             ServiceKind::Bridge => &[],
+            // Everything a run is made of; whatever the deployment has.
+            ServiceKind::Recorder => &[
+                (Topic::Truth, Optional),
+                (Topic::Acquisition, Optional),
+                (Topic::Pose, Optional),
+                (Topic::FilterState, Optional),
+                (Topic::Health, Optional),
+                (Topic::RawCloud, Optional),
+                (Topic::Cloud, Optional),
+            ],
         }
     }
 
@@ -163,6 +178,7 @@ impl ServiceKind {
             ServiceKind::Init => vec![Topic::Acquisition],
             // Its inbound routes, from its config.
             ServiceKind::Bridge => vec![],
+            ServiceKind::Recorder => vec![],
         };
         if self == ServiceKind::LidarSim && truth_init {
             out.push(Topic::Acquisition);

@@ -1,0 +1,120 @@
+//! Configuration of the recorder service (TOML; keys in `README.md`).
+
+use serde::{Deserialize, Serialize};
+use spacepose_foxglove::{Compression, RecordOptions};
+use spacepose_runtime::ServiceConfig;
+use std::path::PathBuf;
+
+/// The recorder's configuration file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RecorderConfig {
+    /// The MCAP file to write. When it exists (a restarted recorder), the
+    /// recording goes on in `<stem>.1.mcap`, `<stem>.2.mcap`, ...
+    pub file: PathBuf,
+    /// Chunk compression: `"lz4"` (default), `"zstd"` or `"none"`.
+    pub compression: Compression,
+    /// Record the raw cloud of every n-th frame (by sequence); 0: none.
+    pub raw_cloud_every: u64,
+    /// Record the cropped cloud of every n-th frame; 0: none.
+    pub cloud_every: u64,
+    /// The target shown at the estimated and true poses, as the tracker
+    /// names it (built-in, package directory or mesh file); `""`: none.
+    pub target: String,
+    /// Scale of a target mesh file (e.g. 0.001 for a model in mm).
+    pub target_scale: f64,
+    /// The deployment descriptor (TOML text), recorded as the attachment
+    /// `descriptor.toml`, with each service's `config` as the metadata
+    /// record `spacepose.config.<instance>`. `""`: none.
+    pub descriptor: String,
+}
+
+impl Default for RecorderConfig {
+    fn default() -> Self {
+        Self {
+            file: PathBuf::from("run.mcap"),
+            compression: Compression::Lz4,
+            raw_cloud_every: 1,
+            cloud_every: 1,
+            target: "deos".to_string(),
+            target_scale: 1.0,
+            descriptor: String::new(),
+        }
+    }
+}
+
+impl RecorderConfig {
+    /// The recording options.
+    pub fn options(&self) -> RecordOptions {
+        RecordOptions {
+            compression: self.compression,
+            raw_cloud_every: self.raw_cloud_every,
+            cloud_every: self.cloud_every,
+        }
+    }
+}
+
+impl ServiceConfig for RecorderConfig {
+    fn validate(&self) -> Result<(), String> {
+        if self.file.as_os_str().is_empty() {
+            return Err("file must not be empty".into());
+        }
+        if self.file.extension().is_none_or(|e| e != "mcap") {
+            return Err(format!("file {} must end in .mcap", self.file.display()));
+        }
+        if !(self.target_scale.is_finite() && self.target_scale > 0.0) {
+            return Err(format!("target_scale = {} must be > 0", self.target_scale));
+        }
+        if !self.descriptor.is_empty() {
+            toml::from_str::<toml::Table>(&self.descriptor)
+                .map_err(|e| format!("descriptor is not TOML: {e}"))?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_bad_values_are_named() {
+        assert_eq!(RecorderConfig::default().validate(), Ok(()));
+        let c: RecorderConfig =
+            toml::from_str("file = \"/tmp/a.mcap\"\ncompression = \"zstd\"\ncloud_every = 5\n")
+                .unwrap();
+        assert_eq!(c.options().compression, Compression::Zstd);
+        assert_eq!(
+            (c.options().cloud_every, c.options().raw_cloud_every),
+            (5, 1)
+        );
+        for (bad, field) in [
+            (
+                RecorderConfig {
+                    target_scale: f64::NAN,
+                    ..RecorderConfig::default()
+                },
+                "target_scale",
+            ),
+            (
+                RecorderConfig {
+                    file: "a.bag".into(),
+                    ..RecorderConfig::default()
+                },
+                "file",
+            ),
+            (
+                RecorderConfig {
+                    descriptor: "x = = 1".into(),
+                    ..RecorderConfig::default()
+                },
+                "descriptor",
+            ),
+        ] {
+            let e = bad.validate().unwrap_err();
+            assert!(e.contains(field), "{e}");
+        }
+        assert!(toml::from_str::<RecorderConfig>("every = 2\n").is_err());
+        assert!(toml::from_str::<RecorderConfig>("compression = \"gzip\"\n").is_err());
+    }
+}
