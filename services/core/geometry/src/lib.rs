@@ -23,7 +23,10 @@ pub mod voxel;
 pub use centroid::{DEFAULT_TRIM, HasPosition, centroid, trimmed_centroid};
 pub use error::GeometryError;
 pub use euler::Euler321;
-pub use io::{CloudFormat, read_cloud, write_cloud};
+pub use io::{
+    CloudFormat, PointTimes, TimeBase, TimeField, TimeMapping, TimeUnit, TimedCloud, read_cloud,
+    read_cloud_timed, write_cloud,
+};
 pub use point::Point;
 pub use pose::Pose;
 pub use voxel::{VoxelFilter, VoxelOutput, voxel_filter};

@@ -5,15 +5,25 @@
 //! write/read round trip is bit-exact in every encoding (ASCII numbers are
 //! printed with Rust's shortest round-trip formatting).
 //!
-//! Reading is tolerant of what other tools produce: `t` and `intensity` may
-//! be missing (they read as 0), `x y z` may be `float` or `double`, `t` may be
-//! `float` or `double`, `intensity` may be any numeric type, and unknown
-//! fields are skipped. Corrupt or truncated files give
+//! Two readers:
+//! - [`read_cloud`], the plain reader for files spacepose writes itself: the
+//!   time is the `t` field (`float` or `double`, absolute seconds) and reads
+//!   as 0 when missing.
+//! - [`read_cloud_timed`], for **recorded input** from other tools: the time
+//!   field is chosen by a [`TimeMapping`] (`t`, `time`, `timestamp`, Livox
+//!   `offset_time`, or a configured name; any numeric type; unit and base
+//!   configurable), and the result says which field was used, or that there
+//!   was none so the caller derives times ([`time`] module).
+//!
+//! Both are tolerant of what other tools produce: `intensity` may be missing
+//! (it reads as 0), `x y z` may be `float` or `double`, `intensity` may be any
+//! numeric type, and unknown fields are skipped. Corrupt or truncated files give
 //! [`GeometryError::Malformed`], never a panic. Whole files are read into
 //! memory first (lidar frames are a few MB).
 
 pub mod pcd;
 pub mod ply;
+pub mod time;
 
 use std::path::Path;
 
@@ -22,6 +32,7 @@ use crate::point::Point;
 
 pub use pcd::{PcdEncoding, read_pcd, write_pcd};
 pub use ply::{PlyEncoding, read_ply, write_ply};
+pub use time::{PointTimes, TimeBase, TimeField, TimeMapping, TimeUnit, TimedCloud};
 
 /// A file format and encoding to write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -59,6 +70,32 @@ pub fn read_cloud(path: impl AsRef<Path>) -> Result<Vec<Point>, GeometryError> {
         Some("ply") => read_ply(path),
         _ => Err(bad_extension(path, "expected a .pcd or .ply extension")),
     }
+}
+
+/// Reads a recorded cloud (`.pcd` or `.ply`) with its per-point time field
+/// chosen by `mapping`. Field times are converted to seconds (relative ones
+/// stay relative: see [`TimedCloud::into_absolute`]); without a time field
+/// every `t` is NaN and [`TimedCloud::time`] is `None`. PLY files recognise
+/// only the names of [`time::TIME_FIELD_NAMES`].
+///
+/// # Errors
+/// As [`read_cloud`], plus [`GeometryError::Unsupported`] when a configured
+/// time field is absent or has more than one value per point.
+pub fn read_cloud_timed(
+    path: impl AsRef<Path>,
+    mapping: &TimeMapping,
+) -> Result<TimedCloud, GeometryError> {
+    let path = path.as_ref();
+    let mut cloud = match lowercase_extension(path).as_deref() {
+        Some("pcd") => pcd::read_pcd_timed(path, mapping)?,
+        Some("ply") => ply::read_ply_timed(path, mapping)?,
+        _ => return Err(bad_extension(path, "expected a .pcd or .ply extension")),
+    };
+    let scale = cloud.time.as_ref().map(|f| f.unit.seconds_per_unit());
+    for p in &mut cloud.points {
+        p.t = scale.map_or(f64::NAN, |s| p.t * s);
+    }
+    Ok(cloud)
 }
 
 /// Writes a cloud in `format`; the extension of `path` must match the format
@@ -99,13 +136,14 @@ enum Role {
 }
 
 impl Role {
-    fn of(name: &str) -> Option<Self> {
+    /// The role of field `name` when the time field is `time_name`.
+    fn of(name: &str, time_name: &str) -> Option<Self> {
         match name {
             "x" => Some(Self::X),
             "y" => Some(Self::Y),
             "z" => Some(Self::Z),
-            "t" => Some(Self::T),
             "intensity" => Some(Self::Intensity),
+            _ if name == time_name => Some(Self::T),
             _ => None,
         }
     }

@@ -20,6 +20,7 @@ use std::path::Path;
 
 use pcd_rs::{DataKind, DynReader, DynRecord, Field, PcdMeta, ValueKind};
 
+use super::time::{TimeMapping, TimedCloud};
 use super::{Issue, Role, io_error};
 use crate::error::GeometryError;
 use crate::point::Point;
@@ -49,6 +50,16 @@ pub fn read_pcd(path: impl AsRef<Path>) -> Result<Vec<Point>, GeometryError> {
     let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(io_error(path))?;
     parse_pcd(&bytes).map_err(|issue| issue.at(path, FORMAT))
+}
+
+/// Reads a PCD file with the time field chosen by `mapping` (raw values in
+/// `t`, unconverted; see [`super::read_cloud_timed`]).
+pub(crate) fn read_pcd_timed(
+    path: &Path,
+    mapping: &TimeMapping,
+) -> Result<TimedCloud, GeometryError> {
+    let bytes = std::fs::read(path).map_err(io_error(path))?;
+    parse_pcd_timed(&bytes, mapping).map_err(|issue| issue.at(path, FORMAT))
 }
 
 /// Writes `points` as PCD v0.7 with fields `x y z t intensity`
@@ -105,11 +116,56 @@ struct Layout {
     record_bytes: usize,
 }
 
+/// The plain reader: time in `t`, a float.
 fn parse_pcd(bytes: &[u8]) -> Result<Vec<Point>, Issue> {
+    decode_pcd(bytes, |_| Ok(TimeChoice::PLAIN))
+}
+
+fn parse_pcd_timed(bytes: &[u8], mapping: &TimeMapping) -> Result<TimedCloud, Issue> {
+    let mut time = None;
+    let points = decode_pcd(bytes, |meta| {
+        let fields = meta.field_defs.iter().map(|d| {
+            let integer = !matches!(d.kind, ValueKind::F32 | ValueKind::F64);
+            (d.name.as_str(), integer)
+        });
+        time = mapping.resolve(fields).map_err(Issue::Unsupported)?;
+        Ok(TimeChoice {
+            name: time.as_ref().map_or(String::new(), |f| f.name.clone()),
+            any_numeric: true,
+        })
+    })?;
+    Ok(TimedCloud { points, time })
+}
+
+/// Which field is the time, and whether it may be an integer.
+struct TimeChoice {
+    name: String,
+    any_numeric: bool,
+}
+
+impl TimeChoice {
+    const PLAIN: TimeChoice = TimeChoice {
+        name: String::new(),
+        any_numeric: false,
+    };
+
+    fn name(&self) -> &str {
+        if self.name.is_empty() && !self.any_numeric {
+            "t"
+        } else {
+            &self.name
+        }
+    }
+}
+
+fn decode_pcd(
+    bytes: &[u8],
+    choose_time: impl FnOnce(&PcdMeta) -> Result<TimeChoice, Issue>,
+) -> Result<Vec<Point>, Issue> {
     let mut cursor = Cursor::new(bytes);
     let meta = PcdMeta::from_reader(&mut cursor).map_err(malformed)?;
     let header_len = cursor.position() as usize;
-    let layout = layout_of(&meta)?;
+    let layout = layout_of(&meta, &choose_time(&meta)?)?;
     let payload = bytes.get(header_len..).unwrap_or_default();
     let capacity = check_payload_size(&meta, &layout, payload)?;
 
@@ -136,7 +192,7 @@ fn parse_pcd(bytes: &[u8]) -> Result<Vec<Point>, Issue> {
 }
 
 /// Maps fields to roles and bounds the record size.
-fn layout_of(meta: &PcdMeta) -> Result<Layout, Issue> {
+fn layout_of(meta: &PcdMeta, time: &TimeChoice) -> Result<Layout, Issue> {
     let mut layout = Layout::default();
     let mut index = 0;
     for def in meta.field_defs.iter() {
@@ -154,8 +210,8 @@ fn layout_of(meta: &PcdMeta) -> Result<Layout, Issue> {
         if def.is_padding() {
             continue; // pcd-rs drops padding from the record
         }
-        if let Some(role) = Role::of(&def.name) {
-            check_field_type(role, &def.name, def.kind, def.count)?;
+        if let Some(role) = Role::of(&def.name, time.name()) {
+            check_field_type(role, &def.name, def.kind, def.count, time.any_numeric)?;
             layout.slots.push((index, role));
         }
         index += 1;
@@ -168,14 +224,21 @@ fn layout_of(meta: &PcdMeta) -> Result<Layout, Issue> {
     Ok(layout)
 }
 
-fn check_field_type(role: Role, name: &str, kind: ValueKind, count: u64) -> Result<(), Issue> {
+fn check_field_type(
+    role: Role,
+    name: &str,
+    kind: ValueKind,
+    count: u64,
+    any_numeric_time: bool,
+) -> Result<(), Issue> {
     if count != 1 {
         return Err(Issue::Unsupported(format!(
             "field {name:?} has COUNT {count}, expected 1"
         )));
     }
     let is_float = matches!(kind, ValueKind::F32 | ValueKind::F64);
-    if role != Role::Intensity && !is_float {
+    let any_numeric = role == Role::Intensity || (role == Role::T && any_numeric_time);
+    if !any_numeric && !is_float {
         return Err(Issue::Unsupported(format!(
             "field {name:?} is {kind:?}; positions and t must be F 4 or F 8"
         )));

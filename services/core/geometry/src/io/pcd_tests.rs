@@ -1,5 +1,6 @@
 use super::*;
 use crate::io::test_support::*;
+use crate::io::time::{TimeBase, TimeMapping, TimeUnit};
 
 #[test]
 fn ascii_and_binary_round_trip_bit_exactly() {
@@ -164,4 +165,49 @@ fn garbage_and_hostile_headers_are_errors_not_panics() {
     for case in &cases {
         assert!(parse_pcd(case.as_bytes()).is_err(), "accepted:\n{case}");
     }
+}
+
+#[test]
+fn the_timed_reader_reports_the_field_or_its_absence() {
+    let dir = tempfile::tempdir().unwrap();
+    let points = awkward_cloud(20, 4);
+    let path = dir.path().join("own.pcd");
+    write_pcd(&path, &points, PcdEncoding::Binary).unwrap();
+    let own = crate::io::read_cloud_timed(&path, &TimeMapping::default()).unwrap();
+    assert_bit_equal(&own.points, &points);
+    assert_eq!(own.time.map(|f| f.name), Some("t".to_owned()));
+
+    let bare = dir.path().join("bare.pcd");
+    let text = header("x y z", "4 4 4", "F F F", 2, "ascii") + "1 2 3\n4 5 6\n";
+    std::fs::write(&bare, text).unwrap();
+    let cloud = crate::io::read_cloud_timed(&bare, &TimeMapping::default()).unwrap();
+    assert!(cloud.time.is_none());
+    assert!(
+        cloud.points.iter().all(|p| p.t.is_nan()),
+        "never a silent t = 0"
+    );
+}
+
+#[test]
+fn livox_offset_time_is_an_integer_in_nanoseconds() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("livox.pcd");
+    let text =
+        header("x y z offset_time", "4 4 4 4", "F F F U", 2, "ascii") + "1 2 3 0\n4 5 6 2500000\n";
+    std::fs::write(&path, text).unwrap();
+    let cloud = crate::io::read_cloud_timed(&path, &TimeMapping::default()).unwrap();
+    let field = cloud.time.unwrap();
+    assert_eq!(
+        (field.name.as_str(), field.unit, field.base),
+        ("offset_time", TimeUnit::Ns, TimeBase::Relative)
+    );
+    assert_eq!(cloud.points[1].t, 2_500_000.0 * 1e-9);
+    // The plain reader still refuses an integer `t`.
+    let int_t = header("x y z t", "4 4 4 4", "F F F U", 1, "ascii") + "1 2 3 7\n";
+    assert!(matches!(
+        parse_pcd(int_t.as_bytes()),
+        Err(Issue::Unsupported(_))
+    ));
+    let timed = parse_pcd_timed(int_t.as_bytes(), &TimeMapping::default()).unwrap();
+    assert_eq!(timed.points[0].t, 7.0);
 }

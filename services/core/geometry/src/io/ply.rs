@@ -21,6 +21,7 @@ use ply_rs_bw::ply::{
 };
 use ply_rs_bw::writer::Writer;
 
+use super::time::{TIME_FIELD_NAMES, TimeMapping, TimedCloud};
 use super::{Issue, Role, io_error};
 use crate::error::GeometryError;
 use crate::point::Point;
@@ -73,35 +74,59 @@ pub fn write_ply(
     std::fs::write(path, bytes).map_err(io_error(path))
 }
 
-/// A [`Point`] as seen by `ply-rs-bw`.
-#[derive(Debug, Clone, Copy, Default)]
-struct PlyPoint(Point);
+/// Reads a PLY file with the time field chosen by `mapping` among
+/// [`TIME_FIELD_NAMES`] (raw values in `t`; see [`super::read_cloud_timed`]).
+pub(crate) fn read_ply_timed(
+    path: &Path,
+    mapping: &TimeMapping,
+) -> Result<TimedCloud, GeometryError> {
+    let bytes = std::fs::read(path).map_err(io_error(path))?;
+    parse_ply_timed(&bytes, mapping).map_err(|issue| issue.at(path, FORMAT))
+}
+
+/// A [`Point`] as seen by `ply-rs-bw`, with the values of every recognised
+/// time property (the parser cannot be told which one is wanted).
+#[derive(Debug, Clone, Copy)]
+struct PlyPoint {
+    point: Point,
+    /// Values of the [`TIME_FIELD_NAMES`] properties, in that order.
+    times: [f64; 4],
+}
 
 impl PlyPoint {
-    fn set(&mut self, name: &str, value: f64) -> PropertyAccessResult {
-        match Role::of(name) {
-            Some(role) => {
-                role.set(&mut self.0, value);
-                PropertyAccessResult::Set
-            }
-            None => PropertyAccessResult::Ignored,
+    fn of(point: Point) -> Self {
+        PlyPoint {
+            point,
+            times: [0.0; 4],
         }
     }
 
-    /// Integers are accepted for intensity only (positions and time in
-    /// integer units would need a scale we do not know).
+    fn set(&mut self, name: &str, value: f64) -> PropertyAccessResult {
+        if let Some(k) = TIME_FIELD_NAMES.iter().position(|n| *n == name) {
+            self.times[k] = value;
+        }
+        match Role::of(name, "t") {
+            Some(role) => role.set(&mut self.point, value),
+            None if TIME_FIELD_NAMES.contains(&name) => {}
+            None => return PropertyAccessResult::Ignored,
+        }
+        PropertyAccessResult::Set
+    }
+
+    /// Integers are accepted for intensity and time only (positions in
+    /// integer units would need a scale we do not know); the plain reader
+    /// refuses integer `t` from the header.
     fn set_integer(&mut self, name: &str, value: f64) -> PropertyAccessResult {
-        match Role::of(name) {
-            Some(Role::Intensity) => self.set(name, value),
-            Some(_) => PropertyAccessResult::UnsupportedType,
-            None => PropertyAccessResult::Ignored,
+        match Role::of(name, "t") {
+            Some(Role::X | Role::Y | Role::Z) => PropertyAccessResult::UnsupportedType,
+            _ => self.set(name, value),
         }
     }
 }
 
 impl PropertyAccess for PlyPoint {
     fn new() -> Self {
-        Self::default()
+        Self::of(Point::default())
     }
     fn set_float(&mut self, name: &str, value: f32) -> PropertyAccessResult {
         self.set(name, value as f64)
@@ -128,20 +153,72 @@ impl PropertyAccess for PlyPoint {
         self.set_integer(name, value as f64)
     }
     fn get_float(&self, name: &str) -> Option<f32> {
-        match Role::of(name)? {
-            Role::X => Some(self.0.x),
-            Role::Y => Some(self.0.y),
-            Role::Z => Some(self.0.z),
-            Role::Intensity => Some(self.0.intensity),
+        match Role::of(name, "t")? {
+            Role::X => Some(self.point.x),
+            Role::Y => Some(self.point.y),
+            Role::Z => Some(self.point.z),
+            Role::Intensity => Some(self.point.intensity),
             Role::T => None,
         }
     }
     fn get_double(&self, name: &str) -> Option<f64> {
-        (Role::of(name)? == Role::T).then_some(self.0.t)
+        (Role::of(name, "t")? == Role::T).then_some(self.point.t)
     }
 }
 
+/// The plain reader: time in `t`, a float.
 fn parse_ply(bytes: &[u8]) -> Result<Vec<Point>, Issue> {
+    let (points, _) = decode_ply(bytes, |_| Ok(Some("t".to_owned())), false)?;
+    Ok(points.into_iter().map(|p| p.point).collect())
+}
+
+fn parse_ply_timed(bytes: &[u8], mapping: &TimeMapping) -> Result<TimedCloud, Issue> {
+    let mut time = None;
+    let (points, _) = decode_ply(
+        bytes,
+        |vertex| {
+            let fields = vertex.properties.iter().map(|(name, def)| {
+                let float = matches!(
+                    def.data_type,
+                    PropertyType::Scalar(ScalarType::Float | ScalarType::Double)
+                );
+                (name.as_str(), !float)
+            });
+            time = mapping.resolve(fields).map_err(Issue::Unsupported)?;
+            Ok(time.as_ref().map(|f| f.name.clone()))
+        },
+        true,
+    )?;
+    let slot = match &time {
+        Some(f) => Some(
+            TIME_FIELD_NAMES
+                .iter()
+                .position(|n| *n == f.name)
+                .ok_or_else(|| {
+                    Issue::Unsupported(format!(
+                        "PLY time field must be one of {TIME_FIELD_NAMES:?}"
+                    ))
+                })?,
+        ),
+        None => None,
+    };
+    let points = points
+        .into_iter()
+        .map(|p| Point {
+            t: slot.map_or(f64::NAN, |k| p.times[k]),
+            ..p.point
+        })
+        .collect();
+    Ok(TimedCloud { points, time })
+}
+
+/// Parses the header, lets `choose_time` pick the time property, checks the
+/// vertex properties and reads the payload.
+fn decode_ply(
+    bytes: &[u8],
+    choose_time: impl FnOnce(&ElementDef) -> Result<Option<String>, Issue>,
+    any_numeric_time: bool,
+) -> Result<(Vec<PlyPoint>, Option<String>), Issue> {
     let parser = Parser::<PlyPoint>::new();
     let mut reader = Reader::new(bytes);
     let header = parser.read_header(&mut reader).map_err(malformed)?;
@@ -149,25 +226,32 @@ fn parse_ply(bytes: &[u8]) -> Result<Vec<Point>, Issue> {
         .elements
         .get(VERTEX)
         .ok_or_else(|| Issue::Malformed("no vertex element".into()))?;
-    check_vertex_properties(vertex)?;
+    let time_name = choose_time(vertex)?;
+    check_vertex_properties(vertex, time_name.as_deref().unwrap_or(""), any_numeric_time)?;
     let mut payload = parser
         .read_payload(&mut reader, &header)
         .map_err(malformed)?;
-    let points = payload.swap_remove(VERTEX).unwrap_or_default();
-    Ok(points.into_iter().map(|p| p.0).collect())
+    Ok((payload.swap_remove(VERTEX).unwrap_or_default(), time_name))
 }
 
-fn check_vertex_properties(vertex: &ElementDef) -> Result<(), Issue> {
+fn check_vertex_properties(
+    vertex: &ElementDef,
+    time_name: &str,
+    any_numeric_time: bool,
+) -> Result<(), Issue> {
     for name in ["x", "y", "z"] {
         if !vertex.properties.contains_key(name) {
             return Err(Issue::Malformed(format!("vertex has no {name} property")));
         }
     }
     for (name, def) in &vertex.properties {
-        let Some(role) = Role::of(name) else { continue };
+        let Some(role) = Role::of(name, time_name) else {
+            continue;
+        };
+        let integer_ok = role == Role::Intensity || (role == Role::T && any_numeric_time);
         match def.data_type {
             PropertyType::Scalar(ScalarType::Float | ScalarType::Double) => {}
-            PropertyType::Scalar(_) if role == Role::Intensity => {}
+            PropertyType::Scalar(_) if integer_ok => {}
             ref other => {
                 return Err(Issue::Unsupported(format!(
                     "vertex property {name} is {other:?}"
@@ -201,7 +285,7 @@ fn encode_ply(points: &[Point], encoding: PlyEncoding) -> std::io::Result<Vec<u8
     ply.header.elements.add(vertex);
     ply.payload.insert(
         VERTEX.to_owned(),
-        points.iter().copied().map(PlyPoint).collect(),
+        points.iter().copied().map(PlyPoint::of).collect(),
     );
     let mut out = Vec::with_capacity(256 + points.len() * 28);
     Writer::new().write_ply(&mut out, &mut ply)?;
@@ -213,113 +297,5 @@ fn malformed(e: impl std::fmt::Display) -> Issue {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::io::test_support::*;
-
-    fn finite_cloud() -> Vec<Point> {
-        awkward_cloud(300, 4)
-    }
-
-    #[test]
-    fn ascii_and_binary_round_trip_bit_exactly() {
-        let points = finite_cloud();
-        for encoding in [PlyEncoding::Ascii, PlyEncoding::BinaryLittleEndian] {
-            let bytes = encode_ply(&points, encoding).unwrap();
-            assert_bit_equal(&parse_ply(&bytes).unwrap(), &points);
-        }
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("cloud.ply");
-        write_ply(&path, &points, PlyEncoding::Ascii).unwrap();
-        assert_bit_equal(&read_ply(&path).unwrap(), &points);
-    }
-
-    #[test]
-    fn non_finite_values_need_binary() {
-        let points = [Point::new(f32::NAN, 1.0, 2.0, 0.0, f64::INFINITY)];
-        let back =
-            parse_ply(&encode_ply(&points, PlyEncoding::BinaryLittleEndian).unwrap()).unwrap();
-        assert!(back[0].x.is_nan() && back[0].t == f64::INFINITY);
-        let dir = tempfile::tempdir().unwrap();
-        assert!(matches!(
-            write_ply(dir.path().join("a.ply"), &points, PlyEncoding::Ascii),
-            Err(GeometryError::Unsupported { .. })
-        ));
-        assert!(
-            parse_ply(&encode_ply(&[], PlyEncoding::Ascii).unwrap())
-                .unwrap()
-                .is_empty()
-        );
-    }
-
-    #[test]
-    fn missing_optional_fields_default_to_zero_and_extras_are_ignored() {
-        let text = "ply\nformat ascii 1.0\ncomment from another tool\nelement vertex 2\n\
-                    property double x\nproperty double y\nproperty double z\n\
-                    property uchar red\nproperty float nx\nelement face 1\n\
-                    property list uchar int vertex_indices\nend_header\n\
-                    1.5 -2 3e2 255 0.5\n0 0 1 0 1\n3 0 1 1\n";
-        let points = parse_ply(text.as_bytes()).unwrap();
-        assert_eq!(
-            points,
-            [
-                Point::new(1.5, -2.0, 300.0, 0.0, 0.0),
-                Point::new(0.0, 0.0, 1.0, 0.0, 0.0)
-            ]
-        );
-    }
-
-    #[test]
-    fn float_time_and_integer_intensity_are_read() {
-        let mut bytes = b"ply\nformat binary_little_endian 1.0\nelement vertex 1\n\
-                          property ushort intensity\nproperty float t\nproperty float x\n\
-                          property float y\nproperty float z\nend_header\n"
-            .to_vec();
-        bytes.extend_from_slice(&4000u16.to_le_bytes());
-        for v in [0.25f32, 1.0, 2.0, 3.0] {
-            bytes.extend_from_slice(&v.to_le_bytes());
-        }
-        assert_eq!(
-            parse_ply(&bytes).unwrap(),
-            [Point::new(1.0, 2.0, 3.0, 4000.0, 0.25)]
-        );
-    }
-
-    #[test]
-    fn truncated_files_are_errors() {
-        let points = awkward_cloud(20, 3);
-        for encoding in [PlyEncoding::Ascii, PlyEncoding::BinaryLittleEndian] {
-            let bytes = encode_ply(&points, encoding).unwrap();
-            for len in [0, 10, 60, bytes.len() / 2, bytes.len() - 30] {
-                assert!(
-                    parse_ply(&bytes[..len]).is_err(),
-                    "{encoding:?} truncated to {len} accepted"
-                );
-            }
-        }
-    }
-
-    #[test]
-    fn garbage_and_hostile_headers_are_errors_not_panics() {
-        let garbage: Vec<u8> = (0..2000u32)
-            .map(|i| (i.wrapping_mul(2654435761) >> 13) as u8)
-            .collect();
-        assert!(parse_ply(&garbage).is_err());
-        let cases: [&[u8]; 7] = [
-            b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n1 2\n",
-            b"ply\nformat ascii 1.0\nelement vertex 1\nproperty int x\nproperty int y\nproperty int z\nend_header\n1 2 3\n",
-            b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 zz\n",
-            b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n",
-            b"ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n\x00\x00",
-            b"ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty list uint float x\nproperty float y\nproperty float z\nend_header\n\xff\xff\xff\xff",
-            b"ply\nformat ascii 1.0\nelement face 1\nproperty float x\nend_header\n1\n",
-        ];
-        for case in cases {
-            assert!(
-                parse_ply(case).is_err(),
-                "accepted:\n{}",
-                String::from_utf8_lossy(case)
-            );
-        }
-    }
-}
+#[path = "ply_tests.rs"]
+mod tests;
