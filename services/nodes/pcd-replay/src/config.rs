@@ -1,6 +1,7 @@
 //! The service's configuration file (keys in `deploy/examples/pcd-replay.toml`).
 
 use serde::Deserialize;
+use spacepose_input::{InputOptions, TimeMapping};
 use spacepose_runtime::ServiceConfig;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -20,6 +21,11 @@ pub struct PcdReplayConfig {
     pub exit_at_end: bool,
     /// Sensor id written in the cloud headers.
     pub sensor_id: u16,
+    /// Which field holds per-point times (`[time]`: `field`, `unit`, `base`).
+    pub time: TimeMapping,
+    /// Scan period (s) for derived times of frames without a time field
+    /// and without a `truth.csv` row; unset: the recorded period, else 0.1 s.
+    pub scan_period_s: Option<f64>,
 }
 
 impl Default for PcdReplayConfig {
@@ -30,6 +36,8 @@ impl Default for PcdReplayConfig {
             looping: false,
             exit_at_end: false,
             sensor_id: 0,
+            time: TimeMapping::default(),
+            scan_period_s: None,
         }
     }
 }
@@ -45,11 +53,20 @@ impl ServiceConfig for PcdReplayConfig {
         if self.dir.as_os_str().is_empty() {
             return Err("dir must not be empty".into());
         }
-        Ok(())
+        self.input_options().validate()
     }
 }
 
 impl PcdReplayConfig {
+    /// How the directory is read: the time mapping and scan period.
+    pub fn input_options(&self) -> InputOptions {
+        InputOptions {
+            topic: None,
+            time: self.time.clone(),
+            scan_period_s: self.scan_period_s,
+        }
+    }
+
     /// The frame period: `1 / rate_hz`, else the recording's (`recorded_s`,
     /// from `truth.csv`), else 1 s.
     pub fn period(&self, recorded_s: Option<f64>) -> Duration {
@@ -93,6 +110,13 @@ mod tests {
         assert!(c.validate().unwrap_err().contains("rate_hz"));
         let c: PcdReplayConfig = toml::from_str("dir = \"\"").unwrap();
         assert!(c.validate().unwrap_err().contains("dir"));
+        let c: PcdReplayConfig = toml::from_str("scan_period_s = nan").unwrap();
+        assert!(c.validate().unwrap_err().contains("scan_period_s"));
+        let c: PcdReplayConfig =
+            toml::from_str("[time]\nfield = \"offset_time\"\nunit = \"ns\"\nbase = \"relative\"\n")
+                .unwrap();
+        assert_eq!(c.time.field.as_deref(), Some("offset_time"));
+        assert!(toml::from_str::<PcdReplayConfig>("[time]\nunits = \"ns\"").is_err());
     }
 
     #[test]

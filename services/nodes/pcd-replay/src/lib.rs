@@ -4,25 +4,18 @@
 //! sensor clock).
 //!
 //! The directory holds `frame_NNNNNN.pcd` / `.ply` files (as written by
-//! `spacepose sim`), read in frame order with
-//! [`spacepose_geometry::read_cloud`] ([`replay`]). Scan times come from
-//! `truth.csv` when present ([`truth`]), otherwise from the point
-//! timestamps. A corrupt file is an error value for that frame only: the
-//! node logs it, counts it and goes on with the next one.
+//! `spacepose sim`, or by other tools), read in frame order with
+//! [`spacepose_input::PcdDir`]: scan times come from `truth.csv` when
+//! present, per-point times from the time field chosen by the configured
+//! [`spacepose_input::TimeMapping`], or are derived over the scan interval
+//! (a logged warning, never t = 0). A corrupt file is an error value for
+//! that frame only: the node logs it, counts it and goes on with the next one.
 #![forbid(unsafe_code)]
 
 pub mod config;
-pub mod error;
 pub mod node;
-pub mod replay;
-pub mod truth;
 pub mod wire;
 
 pub use config::PcdReplayConfig;
-pub use error::ReplayError;
 pub use node::PcdReplayNode;
-pub use replay::{ReplayDir, ReplayFrame, TimeSource};
-pub use truth::{ScanTimes, TruthTimes};
-
-#[cfg(test)]
-mod replay_tests;
+pub use spacepose_input::{InputError, InputFrame, PcdDir};

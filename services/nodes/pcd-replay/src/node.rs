@@ -2,8 +2,8 @@
 //! index order, optionally in a loop that continues the sensor clock.
 
 use crate::config::PcdReplayConfig;
-use crate::replay::{ReplayDir, ReplayFrame};
 use crate::wire::cloud_header;
+use spacepose_input::{InputFrame, PcdDir};
 use spacepose_messages::{MAX_POINTS, ServiceKind, Topic};
 use spacepose_runtime::{Ctx, Flow, Node, NodeInfo};
 use std::time::Duration;
@@ -38,15 +38,17 @@ struct Pass {
 
 /// Publishes a directory of recorded frames as raw clouds.
 pub struct PcdReplayNode {
-    dir: ReplayDir,
+    dir: PcdDir,
     config: PcdReplayConfig,
     period: Duration,
     period_ns: i64,
     pass: Pass,
     /// The next frame, read ahead of its slot.
-    pending: Option<ReplayFrame>,
+    pending: Option<InputFrame>,
     sequence: u64,
     phase: Phase,
+    /// Frames read whose point times were derived (no time field).
+    derived_times: u64,
 }
 
 impl Node for PcdReplayNode {
@@ -54,7 +56,7 @@ impl Node for PcdReplayNode {
     type Config = PcdReplayConfig;
 
     fn new(config: PcdReplayConfig, _: &NodeInfo) -> anyhow::Result<Self> {
-        let dir = ReplayDir::open(&config.dir)?;
+        let dir = PcdDir::open(&config.dir, &config.input_options())?;
         for w in dir.warnings() {
             warn!("{w}");
         }
@@ -74,6 +76,7 @@ impl Node for PcdReplayNode {
             pending: None,
             sequence: 0,
             phase: Phase::Starting,
+            derived_times: 0,
         })
     }
 
@@ -130,7 +133,10 @@ impl PcdReplayNode {
         if self.config.exit_at_end {
             return Flow::Finished;
         }
-        info!("end of the recording; idle");
+        info!(
+            derived_times = self.derived_times,
+            "end of the recording; idle"
+        );
         self.phase = Phase::Idle;
         Flow::Continue
     }
@@ -139,7 +145,7 @@ impl PcdReplayNode {
     /// logged, counted and skipped. `None` at the end of the recording:
     /// the last file without `loop`, or a whole pass without a readable
     /// frame.
-    fn next_frame(&mut self, ctx: &mut Ctx<'_>) -> Option<ReplayFrame> {
+    fn next_frame(&mut self, ctx: &mut Ctx<'_>) -> Option<InputFrame> {
         loop {
             let Some(result) = self.dir.read(self.pass.file) else {
                 self.next_pass()?;
@@ -148,6 +154,7 @@ impl PcdReplayNode {
             self.pass.file += 1;
             match result {
                 Ok(mut frame) => {
+                    self.note_derived_times(&frame);
                     self.pass.first_start.get_or_insert(frame.scan_start_s);
                     self.pass.last_end = Some(frame.scan_end_s);
                     frame.shift_time(self.pass.shift_s);
@@ -178,12 +185,35 @@ impl PcdReplayNode {
         Some(())
     }
 
-    fn publish(&mut self, frame: &ReplayFrame, ctx: &mut Ctx<'_>) {
+    /// Frames without a time field get times derived over their scan
+    /// interval: warned about on the first one, counted, and the count
+    /// logged at the end of the recording.
+    fn note_derived_times(&mut self, frame: &InputFrame) {
+        if !frame.times_derived() {
+            return;
+        }
+        if self.derived_times == 0 {
+            warn!(
+                frame = %frame.origin,
+                "no per-point time field: times derived linearly over the scan interval \
+                 [{}, {}] s in point order (set [time] field in the config if the files have one)",
+                frame.scan_start_s, frame.scan_end_s
+            );
+        }
+        self.derived_times += 1;
+    }
+
+    /// Frames read so far whose point times were derived.
+    pub fn derived_times(&self) -> u64 {
+        self.derived_times
+    }
+
+    fn publish(&mut self, frame: &InputFrame, ctx: &mut Ctx<'_>) {
         ctx.counters.frames_in += 1;
         let header = cloud_header(self.sequence, frame, self.config.sensor_id);
         self.sequence += 1;
         if frame.points.len() > MAX_POINTS {
-            warn!(path = %frame.path.display(), "{} points exceed the capacity", frame.points.len());
+            warn!(frame = %frame.origin, "{} points exceed the capacity", frame.points.len());
             ctx.counters.rejected_oversized += 1;
             return;
         }

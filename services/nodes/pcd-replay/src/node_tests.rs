@@ -73,6 +73,7 @@ fn node(dir: &Path, rate_hz: f64, looping: bool, exit_at_end: bool) -> PcdReplay
         looping,
         exit_at_end,
         sensor_id: 4,
+        ..PcdReplayConfig::default()
     };
     let info = NodeInfo {
         instance: spacepose_messages::Name::new("replay").unwrap(),
@@ -172,6 +173,29 @@ fn a_loop_over_unreadable_files_ends_instead_of_spinning() {
     assert_eq!((n.phase(), c.errors, c.frames_in), (Phase::Idle, 3, 0));
     let mut n = node(tmp.path(), 25.0, true, true);
     assert_eq!(poll(&mut n, &mut c, T0).0, Flow::Finished);
+}
+
+#[test]
+fn frames_without_a_time_field_get_derived_times_and_are_counted() {
+    let tmp = tempfile::tempdir().unwrap();
+    recording(tmp.path(), &[], &[]);
+    let mut text = String::from(
+        "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\n\
+         HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA ascii\n",
+    );
+    text.push_str("0 0 10\n1 0 10\n2 0 10\n");
+    std::fs::write(tmp.path().join("frame_000001.pcd"), text).unwrap();
+    let mut n = node(tmp.path(), 10.0, false, true);
+    let mut c = Counters::default();
+    poll(&mut n, &mut c, T0);
+    let (_, sent) = poll(&mut n, &mut c, T0);
+    assert_eq!(n.derived_times(), 1);
+    let (header, points) = &sent[0];
+    // truth.csv row 1: [1.28, 2.0]; times spread over it, never 0.
+    assert_eq!((header.scan_start_s, header.scan_end_s), (1.28, 2.0));
+    let t: Vec<f64> = points.iter().map(|p| p.t).collect();
+    assert_eq!((t[0], t[2]), (1.28, 2.0));
+    assert!((t[1] - 1.64).abs() < 1e-12);
 }
 
 #[test]
