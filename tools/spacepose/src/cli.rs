@@ -79,6 +79,11 @@ pub struct UpArgs {
     /// `--host b` with deploy/partitioned.toml.
     #[arg(long)]
     pub host: Option<String>,
+    /// Record the run into this MCAP file (Foxglove schemas: clouds,
+    /// poses, filter states, acquisitions, health, truth, the target
+    /// model, the descriptor); docs/recording.md.
+    #[arg(long, value_name = "RUN.mcap")]
+    pub record: Option<PathBuf>,
     /// Overrides.
     #[command(flatten)]
     pub overrides: ZenohOverrideArgs,
@@ -149,6 +154,10 @@ pub struct DemoArgs {
     /// Swap the primary tracker during the run: `MODE@K` (e.g. `ct-ndt@5`).
     #[arg(long)]
     pub swap: Option<String>,
+    /// Record the run into this MCAP file (Foxglove schemas, truth
+    /// included); docs/recording.md.
+    #[arg(long, value_name = "RUN.mcap")]
+    pub record: Option<PathBuf>,
     /// Overrides (default prefix: a fresh random one).
     #[command(flatten)]
     pub overrides: ZenohOverrideArgs,

@@ -13,14 +13,21 @@ fn overrides(a: &ZenohOverrideArgs) -> Overrides {
         listen: (!a.listen.is_empty()).then(|| a.listen.clone()),
         connect: (!a.connect.is_empty()).then(|| a.connect.clone()),
         host: None,
+        record: None,
     }
 }
 
-fn up_overrides(a: &UpArgs) -> Overrides {
-    Overrides {
+/// The recording of `--record`, checked ([`super::record::record_path`]).
+fn record(arg: Option<&std::path::Path>) -> Result<Option<std::path::PathBuf>> {
+    arg.map(super::record::record_path).transpose()
+}
+
+fn up_overrides(a: &UpArgs) -> Result<Overrides> {
+    Ok(Overrides {
         host: a.host.clone(),
+        record: record(a.record.as_deref())?,
         ..overrides(&a.overrides)
-    }
+    })
 }
 
 fn seconds(name: &str, s: f64) -> Result<Duration> {
@@ -32,12 +39,12 @@ fn seconds(name: &str, s: f64) -> Result<Duration> {
 
 /// `spacepose up`.
 pub fn up(a: &UpArgs) -> Result<()> {
-    super::up::run(&a.deploy, &up_overrides(a), &mut std::io::stdout())
+    super::up::run(&a.deploy, &up_overrides(a)?, &mut std::io::stdout())
 }
 
 /// `spacepose supervise` (started by `up`).
 pub fn supervise(a: &UpArgs) -> Result<()> {
-    super::up::supervise(&a.deploy, &up_overrides(a))
+    super::up::supervise(&a.deploy, &up_overrides(a)?)
 }
 
 /// `spacepose swap`.
@@ -81,7 +88,10 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
             .transpose()?,
         warmup: a.warmup,
         json: a.json.clone(),
-        overrides: overrides(&a.overrides),
+        overrides: Overrides {
+            record: record(a.record.as_deref())?,
+            ..overrides(&a.overrides)
+        },
         linger: seconds("--linger-s", a.linger_s)?,
         chaos: a
             .chaos

@@ -14,6 +14,7 @@ pub mod partition;
 pub mod plan;
 pub mod problems;
 pub mod process;
+pub mod record;
 pub mod restart;
 pub mod state;
 pub mod status;

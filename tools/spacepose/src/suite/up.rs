@@ -24,6 +24,9 @@ pub struct Overrides {
     pub connect: Option<Vec<String>>,
     /// The host whose part of a partitioned descriptor to start.
     pub host: Option<String>,
+    /// Record the run into this MCAP file (absolute): a recorder instance
+    /// is added ([`super::record::add_recorder`]).
+    pub record: Option<std::path::PathBuf>,
 }
 
 impl Overrides {
@@ -37,6 +40,9 @@ impl Overrides {
         }
         if let Some(c) = &self.connect {
             d.zenoh.connect.clone_from(c);
+        }
+        if let Some(file) = &self.record {
+            super::record::add_recorder(d, file);
         }
     }
 }
@@ -118,6 +124,9 @@ fn override_args(overrides: &Overrides) -> Vec<String> {
     }
     if let Some(h) = &overrides.host {
         args.extend(["--host".to_string(), h.clone()]);
+    }
+    if let Some(r) = &overrides.record {
+        args.extend(["--record".to_string(), r.display().to_string()]);
     }
     args
 }
