@@ -27,6 +27,9 @@ pub struct RecorderConfig {
     /// `descriptor.toml`, with each service's `config` as the metadata
     /// record `spacepose.config.<instance>`. `""`: none.
     pub descriptor: String,
+    /// Scheduling niceness of the recorder (0-19): the recorder is off the
+    /// frame path, so it yields the CPU to the services on it.
+    pub nice: i32,
 }
 
 impl Default for RecorderConfig {
@@ -39,6 +42,7 @@ impl Default for RecorderConfig {
             target: "deos".to_string(),
             target_scale: 1.0,
             descriptor: String::new(),
+            nice: 10,
         }
     }
 }
@@ -64,6 +68,9 @@ impl ServiceConfig for RecorderConfig {
         }
         if !(self.target_scale.is_finite() && self.target_scale > 0.0) {
             return Err(format!("target_scale = {} must be > 0", self.target_scale));
+        }
+        if !(0..=19).contains(&self.nice) {
+            return Err(format!("nice = {} must be in 0..=19", self.nice));
         }
         if !self.descriptor.is_empty() {
             toml::from_str::<toml::Table>(&self.descriptor)

@@ -26,6 +26,10 @@ impl Node for RecorderNode {
                 path.display()
             );
         }
+        // Linux niceness is per thread: this one runs the node's loop.
+        if let Err(e) = rustix::process::setpriority_process(None, config.nice) {
+            tracing::warn!("nice {}: {e}", config.nice);
+        }
         let mut recorder = Recorder::create(&path, config.options())?;
         if !config.target.is_empty() {
             recorder.set_target(target_mesh(&config.target, config.target_scale)?);
