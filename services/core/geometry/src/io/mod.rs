@@ -21,6 +21,7 @@
 //! [`GeometryError::Malformed`], never a panic. Whole files are read into
 //! memory first (lidar frames are a few MB).
 
+mod fields;
 pub mod pcd;
 pub mod ply;
 pub mod time;
@@ -122,75 +123,6 @@ pub fn write_cloud(
         CloudFormat::PcdBinary => write_pcd(path, points, PcdEncoding::Binary),
         CloudFormat::PlyAscii => write_ply(path, points, PlyEncoding::Ascii),
         CloudFormat::PlyBinary => write_ply(path, points, PlyEncoding::BinaryLittleEndian),
-    }
-}
-
-/// The [`Point`] field a file field maps to, by name.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Role {
-    X,
-    Y,
-    Z,
-    T,
-    Intensity,
-}
-
-impl Role {
-    /// The role of field `name` when the time field is `time_name`.
-    fn of(name: &str, time_name: &str) -> Option<Self> {
-        match name {
-            "x" => Some(Self::X),
-            "y" => Some(Self::Y),
-            "z" => Some(Self::Z),
-            "intensity" => Some(Self::Intensity),
-            _ if name == time_name => Some(Self::T),
-            _ => None,
-        }
-    }
-
-    /// Stores `value` into the matching field of `p` (narrowing to `f32`
-    /// for everything but `t`).
-    #[inline]
-    fn set(self, p: &mut Point, value: f64) {
-        match self {
-            Self::X => p.x = value as f32,
-            Self::Y => p.y = value as f32,
-            Self::Z => p.z = value as f32,
-            Self::T => p.t = value,
-            Self::Intensity => p.intensity = value as f32,
-        }
-    }
-}
-
-/// A problem found while decoding file content, before the path is attached.
-#[derive(Debug)]
-enum Issue {
-    Malformed(String),
-    Unsupported(String),
-}
-
-impl Issue {
-    fn at(self, path: &Path, format: &'static str) -> GeometryError {
-        let path = path.to_path_buf();
-        match self {
-            Self::Malformed(message) => GeometryError::Malformed {
-                path,
-                format,
-                message,
-            },
-            Self::Unsupported(message) => GeometryError::Unsupported {
-                path,
-                format,
-                message,
-            },
-        }
-    }
-}
-
-fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> GeometryError + '_ {
-    move |source| GeometryError::Io {
-        path: path.to_path_buf(),
-        source,
     }
 }
 

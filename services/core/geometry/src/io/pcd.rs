@@ -20,8 +20,8 @@ use std::path::Path;
 
 use pcd_rs::{DataKind, DynReader, DynRecord, Field, PcdMeta, ValueKind};
 
+use super::fields::{Issue, Role, io_error};
 use super::time::{TimeMapping, TimedCloud};
-use super::{Issue, Role, io_error};
 use crate::error::GeometryError;
 use crate::point::Point;
 

@@ -21,8 +21,8 @@ use ply_rs_bw::ply::{
 };
 use ply_rs_bw::writer::Writer;
 
+use super::fields::{Issue, Role, io_error};
 use super::time::{TIME_FIELD_NAMES, TimeMapping, TimedCloud};
-use super::{Issue, Role, io_error};
 use crate::error::GeometryError;
 use crate::point::Point;
 
