@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The committed Monte-Carlo reports: `eval tracking --report` over the blind
 # seeds of tools/eval/seeds.toml, 120 frames per run, on deos, from the
-# truth with zero rates (the start-up counts). `spacepose eval tables`
+# truth with zero rates (the start-up counts), and `acquired`: the deployed
+# path from a no-truth start (`--init acquire`: init's CNN, then template
+# matching, acquire on the frames and reacquire after a loss). `spacepose eval tables`
 # turns them into the table of docs/results.md.
 #   docs/results/monte-carlo/measure.sh <spacepose binary>
 # Each report takes 5-15 minutes on this project's 2-core machine.
@@ -9,15 +11,16 @@ set -euo pipefail
 bin=$(realpath "$1")
 here=docs/results/monte-carlo
 cd "$(dirname "$0")/../../.."
-run() { # scenario, mode, name, [tracker config]
+run() { # scenario, mode, name, [tracker config], [more arguments]
   local cfg=()
   [ -n "${4:-}" ] && cfg=(--tracker-config "$here/$4.toml")
   "$bin" eval tracking --scenario "$1" --frames 120 --mode "$2" "${cfg[@]}" \
-    --report "$here/deos-$1-$3.json" >/dev/null
+    "${@:5}" --report "$here/deos-$1-$3.json" >/dev/null
 }
 for sc in tumbling slow-spin; do
   run $sc all defaults
   run $sc deblur no-start-up no-start-up
+  run $sc deblur,ct-ndt acquired "" --init acquire
 done
 for sc in tumbling slow-spin; do
   for m in ndt deblur ct-ndt; do

@@ -16,6 +16,8 @@ pub enum AcquisitionMethod {
     TemplateMatching = 1,
     /// CNN pose regression (seed 004).
     Cnn = 2,
+    /// A pose the operator gave (`spacepose track --init POSE`).
+    Given = 3,
 }
 
 impl AcquisitionMethod {
@@ -25,6 +27,7 @@ impl AcquisitionMethod {
             0 => Ok(AcquisitionMethod::Truth),
             1 => Ok(AcquisitionMethod::TemplateMatching),
             2 => Ok(AcquisitionMethod::Cnn),
+            3 => Ok(AcquisitionMethod::Given),
             _ => Err(MessageError::UnknownCode {
                 what: "acquisition method",
                 code,
@@ -32,12 +35,13 @@ impl AcquisitionMethod {
         }
     }
 
-    /// Lower-case name (`"truth"`, `"template-matching"`, `"cnn"`).
+    /// Lower-case name (`"truth"`, `"template-matching"`, `"cnn"`, `"given"`).
     pub fn as_str(self) -> &'static str {
         match self {
             AcquisitionMethod::Truth => "truth",
             AcquisitionMethod::TemplateMatching => "template-matching",
             AcquisitionMethod::Cnn => "cnn",
+            AcquisitionMethod::Given => "given",
         }
     }
 }
@@ -89,7 +93,7 @@ impl WireMessage for AcquisitionResult {
     }
 
     fn validate(&self) -> Result<(), CodecError> {
-        check_code("method", self.method, AcquisitionMethod::Cnn as u8)?;
+        check_code("method", self.method, AcquisitionMethod::Given as u8)?;
         check_code("success", self.success, 1)?;
         check_name("instance", &self.instance)
     }

@@ -22,6 +22,7 @@ pub mod table;
 pub mod tables;
 pub mod target;
 pub mod tm;
+pub mod track;
 pub mod tracking;
 pub mod train;
 pub mod truth_csv;

@@ -11,6 +11,13 @@ pub struct MeanMax {
     pub max: f64,
 }
 
+impl Default for MeanMax {
+    /// The figures of an empty series (NaN).
+    fn default() -> Self {
+        Self::of(&[])
+    }
+}
+
 impl MeanMax {
     /// Mean and max of the finite values of `values`; NaN when none is finite.
     pub fn of(values: &[f64]) -> Self {

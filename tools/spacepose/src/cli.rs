@@ -25,6 +25,9 @@ pub enum Command {
     /// Train a CNN for a target package into its cnn/ directory (datasets,
     /// PyTorch training, export, check); needs tools/train/setup.sh.
     Train(spacepose_eval::train::TrainArgs),
+    /// Track a recording (PCD/PLY directory, MCAP file, ROS 2 bag) with the
+    /// suite's frame pipeline in one process, and write the poses.
+    Track(spacepose_eval::track::TrackArgs),
     /// Evaluate an estimator against ground truth.
     #[command(subcommand)]
     Eval(EvalCommand),

@@ -14,6 +14,7 @@ fn main() -> ExitCode {
         Command::Sim(args) => spacepose_eval::sim::run(&args),
         Command::Dataset(args) => spacepose_eval::dataset::run(&args),
         Command::Train(args) => spacepose_eval::train::run(&args),
+        Command::Track(args) => spacepose_eval::track::run(&args),
         Command::Eval(EvalCommand::Tracking(args)) => spacepose_eval::tracking::run(&args),
         Command::Eval(EvalCommand::Cnn(args)) => spacepose_eval::cnn::run(&args),
         Command::Eval(EvalCommand::Tm(args)) => spacepose_eval::tm::run(&args),

@@ -40,6 +40,20 @@ pub struct Counts {
     pub diverged: usize,
     /// Frames published as tracking while off.
     pub silent: usize,
+    /// Acquisitions by verdict (absent from reports started from the truth).
+    #[serde(default)]
+    pub acquisitions: Acquisitions,
+}
+
+/// A seed's acquisitions by verdict.
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+pub struct Acquisitions {
+    /// Accepted within the far-off bound.
+    pub correct: usize,
+    /// Accepted beyond it.
+    pub false_accepts: usize,
+    /// Refused by the checks.
+    pub rejected: usize,
 }
 
 /// One `--report` file.
@@ -93,12 +107,15 @@ fn cell(v: Option<f64>, decimals: usize) -> String {
 /// position, and the failures summed over the seeds.
 pub fn table(reports: &[(String, Report)]) -> String {
     let mut out = String::from(
-        "Whole runs from the truth with zero rates, start-up included; one row per \
+        "Whole runs from the truth with zero rates, or, where the configuration says \
+         \"acquired by init\", from init's acquisitions with no truth (errors then with d_sym \
+         over the target's symmetries); start-up included; one row per \
          report file and mode; \"max\" is each seed's largest error, then its mean / p95 / \
-         max over the seeds.\n\n",
+         max over the seeds. Acquisitions: correct / false accepts / rejected, summed over \
+         the seeds (a false accept is an accepted pose more than 10° or 50 cm off).\n\n",
     );
-    out.push_str("| file | target | scenario | configuration | mode | seeds × frames | angle max: mean / p95 / max (°) | angle mean (95 % CI) (°) | position mean / p95 of max (cm) | lost | diverged | silent |\n");
-    out.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    out.push_str("| file | target | scenario | configuration | mode | seeds × frames | angle max: mean / p95 / max (°) | angle mean (95 % CI) (°) | position mean / p95 of max (cm) | lost | diverged | silent | acquisitions |\n");
+    out.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (file, r) in reports {
         for (mode, m) in &r.modes {
             let get = |k: &str| m.stats.get(k).copied();
@@ -106,7 +123,7 @@ pub fn table(reports: &[(String, Report)]) -> String {
             let mean = get("ang_mean_deg");
             let sum = |f: fn(&Counts) -> usize| m.per_seed.iter().map(f).sum::<usize>();
             out.push_str(&format!(
-                "| {file} | {} | {} | {} | {mode} | {} × {} ({}) | {} / {} / {} | {} ({}-{}) | {} / {} | {} | {} | {} |\n",
+                "| {file} | {} | {} | {} | {mode} | {} × {} ({}) | {} / {} / {} | {} ({}-{}) | {} / {} | {} | {} | {} | {} |\n",
                 r.target,
                 r.scenario,
                 r.configuration,
@@ -124,10 +141,29 @@ pub fn table(reports: &[(String, Report)]) -> String {
                 sum(|c| c.lost),
                 sum(|c| c.diverged),
                 sum(|c| c.silent),
+                acquisitions(m),
             ));
         }
     }
     out
+}
+
+/// `correct / false accepts / rejected` over the seeds, `-` when the
+/// runs started from the truth.
+fn acquisitions(m: &Mode) -> String {
+    let sum = |f: fn(&Acquisitions) -> usize| {
+        m.per_seed.iter().map(|c| f(&c.acquisitions)).sum::<usize>()
+    };
+    let (c, f, r) = (
+        sum(|a| a.correct),
+        sum(|a| a.false_accepts),
+        sum(|a| a.rejected),
+    );
+    if c + f + r == 0 {
+        "-".to_string()
+    } else {
+        format!("{c} / {f} / {r}")
+    }
 }
 
 /// The README's table: the suite's defaults (`*-defaults` reports), per

@@ -47,6 +47,17 @@ impl FromStr for Modes {
     }
 }
 
+/// `--init`: how every suite starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum EvalInit {
+    /// The sensor's truth acquisition of the first frame (`truth_init`).
+    Truth,
+    /// The init service's methods on the frames, as deployed (the CNN when
+    /// the target has a model, then template matching), reacquiring after
+    /// a loss: no truth reaches the suite.
+    Acquire,
+}
+
 /// `spacepose eval tracking`.
 #[derive(Debug, Args)]
 pub struct EvalTrackingArgs {
@@ -102,6 +113,9 @@ pub struct EvalTrackingArgs {
     /// `filter-prior`. Default: the tracker's (filter-prior).
     #[arg(long)]
     pub ct_start: Option<CtStart>,
+    /// How every suite starts: from the truth, or acquiring with init.
+    #[arg(long, value_enum, default_value = "truth")]
+    pub init: EvalInit,
     /// Write the results as JSON.
     #[arg(long)]
     pub json: Option<PathBuf>,

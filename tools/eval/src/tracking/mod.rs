@@ -21,6 +21,7 @@
 //!   and the truth (d of seed 004 Eq. 12; a symmetric flip counts when
 //!   tracking) and the distance between their centres of mass.
 
+pub mod acquisition;
 mod args;
 pub mod deployed;
 pub mod frames;
@@ -28,80 +29,24 @@ pub mod monte_carlo;
 mod plot;
 mod render;
 pub mod report;
+mod setup;
 
-pub use args::{EvalTrackingArgs, Modes};
+pub use args::{EvalInit, EvalTrackingArgs, Modes};
 pub use deployed::{Answer, DeployedSuite, SuiteConfigs};
 pub use report::{DIVERGED_DEG, DIVERGED_M, FrameRecord, ModeReport, TrackingReport};
+pub use setup::{EvalConfig, Setup, frame_source};
 
 use crate::common::{load_target, progress_bar};
 use crate::stats::MeanMax;
 use anyhow::{Context, Result, bail};
-use spacepose_ingest_node::IngestServiceConfig;
+use nalgebra::Rotation3;
+use spacepose_init_node::{InitServiceConfig, MethodKind};
 use spacepose_lidar_sim::FrameSource;
-use spacepose_lidar_sim_node::LidarSimConfig;
 use spacepose_lidar_sim_node::wire::{cloud_header, truth_acquisition};
 use spacepose_messages::Name;
 use spacepose_scenario::ScenarioKind;
-use spacepose_tracker::{TrackerConfig, TrackingMode, TrackingModel};
-use spacepose_tracker_node::TrackerServiceConfig;
+use spacepose_tracker::TrackerConfig;
 use std::path::Path;
-
-/// What to evaluate (the library form of the command-line arguments).
-#[derive(Debug, Clone)]
-pub struct EvalConfig {
-    /// Scenario.
-    pub scenario: ScenarioKind,
-    /// Modes to run on the same frames.
-    pub modes: Vec<TrackingMode>,
-    /// Frames (None: the whole scenario).
-    pub frames: Option<usize>,
-    /// Seed of the scenario and the sensor.
-    pub seed: u64,
-    /// Chaser-trajectory compression.
-    pub compression: f64,
-    /// First frame to run; the truth acquisition is that frame's.
-    pub first_frame: usize,
-    /// Target name or mesh path, and its scale.
-    pub target: (String, f64),
-    /// Frames excluded from the converged statistics.
-    pub warmup: usize,
-    /// Overrides the tracker's NDT `min_lever_arm_m` (and
-    /// `ndt_mode_min_lever_arm_m`, its value in `ndt` mode).
-    pub min_lever_arm_m: Option<f64>,
-    /// Overrides the tracker's `geometric_sigma_m`.
-    pub geometric_sigma_m: Option<f64>,
-    /// Overrides the tracker's `ct_start`.
-    pub ct_start: Option<spacepose_tracker::CtStart>,
-    /// Base tracker configuration (the defaults when `None`).
-    pub tracker: Option<TrackerConfig>,
-    /// Ingest's configuration (default: the service's, on this target, whose
-    /// package gives the crop region).
-    pub ingest: Option<IngestServiceConfig>,
-}
-
-impl EvalConfig {
-    /// `modes` on `scenario` with `target` (name or path, scale), with the
-    /// command line's defaults for the rest: the whole scenario, seed 1,
-    /// no compression, from the first frame, 10 warm-up frames, the
-    /// services' default configurations.
-    pub fn new(target: (String, f64), scenario: ScenarioKind, modes: Vec<TrackingMode>) -> Self {
-        EvalConfig {
-            scenario,
-            modes,
-            frames: None,
-            seed: 1,
-            compression: 1.0,
-            first_frame: 0,
-            target,
-            warmup: 10,
-            min_lever_arm_m: None,
-            geometric_sigma_m: None,
-            ct_start: None,
-            tracker: None,
-            ingest: None,
-        }
-    }
-}
 
 /// Runs the evaluation.
 pub fn evaluate(config: &EvalConfig) -> Result<TrackingReport> {
@@ -125,94 +70,8 @@ pub fn evaluate(config: &EvalConfig) -> Result<TrackingReport> {
     }
     let setup = Setup::new(config)?;
     let mut suites = setup.suites()?;
-    let tracked = run_frames(config, &source, frames, &mut suites)?;
+    let tracked = run_frames(config, &source, frames, &mut suites, target.symmetries())?;
     Ok(tracked.report(config, source.scenario().name(), target.name(), frames))
-}
-
-/// The suites of an evaluation, one per mode, before any frame: their
-/// configurations and the tracker's model (built once, as each tracker
-/// service builds it from its config). The Criterion benchmark
-/// `tracking_cost` starts its suites from it too.
-pub struct Setup {
-    /// Per mode of the evaluation, the suite's configurations.
-    pub configs: Vec<SuiteConfigs>,
-    /// The tracker's model of the target.
-    pub model: TrackingModel,
-}
-
-impl Setup {
-    /// The setup of `config`'s modes on its target.
-    pub fn new(config: &EvalConfig) -> Result<Setup> {
-        let base = suite_configs(config)?;
-        let (model, _) = base.tracker.build_model().context("building the NDT map")?;
-        let configs = config
-            .modes
-            .iter()
-            .map(|&mode| {
-                let mut c = base.clone();
-                c.tracker.tracker.mode = mode;
-                c
-            })
-            .collect();
-        Ok(Setup { configs, model })
-    }
-
-    /// Fresh suites, one per mode.
-    pub fn suites(&self) -> Result<Vec<DeployedSuite>> {
-        self.configs
-            .iter()
-            .map(|c| DeployedSuite::new(c, self.model.clone()))
-            .collect()
-    }
-}
-
-/// The sensor's frames for `config` (the simulated sensor's own source).
-pub fn frame_source(config: &EvalConfig) -> Result<FrameSource> {
-    let sensor = LidarSimConfig {
-        target: config.target.0.clone(),
-        scale: config.target.1,
-        scenario: config.scenario,
-        seed: config.seed,
-        compression: config.compression,
-        ..LidarSimConfig::default()
-    };
-    // One frame period of integration: 1 s at the scenarios' 1 Hz.
-    let period = sensor.frame_source()?.scenario().frame_period_s();
-    frames::sensor_config(sensor, period).frame_source()
-}
-
-/// The services' configurations: the defaults, the target's crop, and the
-/// tracker options of `config` (the mode is set per suite).
-fn suite_configs(config: &EvalConfig) -> Result<SuiteConfigs> {
-    let mut tracker = config.tracker.clone().unwrap_or_default();
-    if let Some(lever) = config.min_lever_arm_m {
-        tracker.ndt.min_lever_arm_m = lever;
-        tracker.ndt_mode_min_lever_arm_m = lever;
-    }
-    if let Some(sigma) = config.geometric_sigma_m {
-        tracker.geometric_sigma_m = sigma;
-    }
-    if let Some(start) = config.ct_start {
-        tracker.ct_start = start;
-    }
-    let ingest = config
-        .ingest
-        .clone()
-        .unwrap_or_else(|| IngestServiceConfig {
-            target: config.target.0.clone(),
-            target_scale: config.target.1,
-            ..IngestServiceConfig::default()
-        });
-    Ok(SuiteConfigs {
-        ingest,
-        tracker: TrackerServiceConfig {
-            target: config.target.0.clone(),
-            target_scale: config.target.1,
-            tracker,
-            ..TrackerServiceConfig::default()
-        },
-        filter: Default::default(),
-    })
 }
 
 /// What the frame loop collects: the records of each suite, and the
@@ -224,13 +83,21 @@ struct Tracked {
 }
 
 /// Simulates the frames in batches and runs every suite on each, behind a
-/// progress bar; the first frame's truth acquisition starts every suite.
+/// progress bar; the first frame's truth acquisition starts every suite,
+/// unless they acquire (`config.init`): then init's acquisitions are
+/// scored, and the errors use d_sym over the target's `symmetries`.
 fn run_frames(
     config: &EvalConfig,
     source: &FrameSource,
     frames: usize,
     suites: &mut [DeployedSuite],
+    symmetries: &[Rotation3<f64>],
 ) -> Result<Tracked> {
+    let symmetries = if config.init.is_some() {
+        symmetries
+    } else {
+        &[]
+    };
     let mut tracked = Tracked {
         records: vec![Vec::with_capacity(frames); suites.len()],
         points_total: 0,
@@ -244,7 +111,7 @@ fn run_frames(
         let batch = frames::simulate_batch(source, first + start as u64, count)?;
         for (offset, frame) in batch.iter().enumerate() {
             let k = first + (start + offset) as u64;
-            if start + offset == 0 {
+            if start + offset == 0 && config.init.is_none() {
                 suites
                     .iter_mut()
                     .for_each(|s| s.acquire(truth_acquisition(frame, sensor)));
@@ -254,9 +121,13 @@ fn run_frames(
             tracked.lags.push(lag);
             for (suite, out) in suites.iter_mut().zip(tracked.records.iter_mut()) {
                 let answer = suite.track(cloud_header(k, frame, 0), frame.points.clone())?;
-                let mut r =
-                    report::record(frame, k as usize, &answer.estimate, answer.output.as_ref());
+                let output = answer.output.as_ref();
+                let mut r = report::record(frame, k as usize, &answer.estimate, output, symmetries);
                 r.blur_lag_deg = lag;
+                r.acquisition = answer.acquisitions.last().map(|a| {
+                    let truth = &frame.truth.t_sensor_target;
+                    acquisition::score(k, a, Some(truth), symmetries)
+                });
                 out.push(r);
             }
             bar.inc(1);
@@ -317,10 +188,13 @@ pub fn run(args: &EvalTrackingArgs) -> Result<()> {
 /// `--report`: the Monte-Carlo over `--seeds`, printed and written.
 fn run_report(args: &EvalTrackingArgs, config: &EvalConfig, path: &Path) -> Result<()> {
     let seeds = crate::seeds::SeedLists::committed()?.scenario_seeds(&args.seeds)?;
-    let configuration = args.tracker_config.as_ref().map_or_else(
+    let mut configuration = args.tracker_config.as_ref().map_or_else(
         || "defaults".to_string(),
         |p| format!("tracker config {}", p.display()),
     );
+    if args.init == EvalInit::Acquire {
+        configuration += ", acquired by init";
+    }
     let evaluate_seed = |seed| {
         evaluate(&EvalConfig {
             seed,
@@ -356,6 +230,13 @@ fn eval_config(args: &EvalTrackingArgs) -> Result<EvalConfig> {
             .map(load_tracker_config)
             .transpose()?,
         ingest: None,
+        init: match args.init {
+            EvalInit::Truth => None,
+            EvalInit::Acquire => Some(InitServiceConfig {
+                methods: vec![MethodKind::Cnn, MethodKind::TemplateMatching],
+                ..InitServiceConfig::default()
+            }),
+        },
     })
 }
 

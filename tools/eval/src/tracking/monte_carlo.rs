@@ -7,6 +7,7 @@
 //! with no value (NaN: no pose at all) is written as `null`;
 //! `crate::tables::monte_carlo` reads the files back.
 
+use super::acquisition::AcquisitionCounts;
 use super::report::{FrameRecord, TrackingReport};
 use anyhow::Result;
 use rayon::prelude::*;
@@ -38,6 +39,8 @@ pub struct SeedFigures {
     pub diverged: usize,
     /// Frames published as `tracking` while more than 10° or 50 cm off.
     pub silent: usize,
+    /// Acquisitions by verdict (`--init acquire`; zero from the truth).
+    pub acquisitions: AcquisitionCounts,
 }
 
 /// A figure over the seeds.
@@ -150,10 +153,8 @@ pub fn figures(seed: u64, series: &[FrameRecord], warmup: usize) -> SeedFigures 
             .iter()
             .filter(|r| r.status == TrackStatus::Lost || r.far_off())
             .count(),
-        silent: series
-            .iter()
-            .filter(|r| r.status == TrackStatus::Tracking && r.far_off())
-            .count(),
+        silent: series.iter().filter(|r| r.silent()).count(),
+        acquisitions: AcquisitionCounts::of(series.iter().filter_map(|r| r.acquisition.as_ref())),
     }
 }
 
@@ -161,7 +162,7 @@ pub fn figures(seed: u64, series: &[FrameRecord], warmup: usize) -> SeedFigures 
 /// makes its spread NaN rather than vanish.
 fn spreads(per_seed: &[SeedFigures]) -> BTreeMap<String, Spread> {
     let column = |f: fn(&SeedFigures) -> f64| per_seed.iter().map(f).collect::<Vec<_>>();
-    let columns: [(&str, Vec<f64>); 9] = [
+    let columns: [(&str, Vec<f64>); 12] = [
         ("ang_max_deg", column(|s| s.ang_max_deg)),
         ("ang_mean_deg", column(|s| s.ang_mean_deg)),
         (
@@ -174,6 +175,12 @@ fn spreads(per_seed: &[SeedFigures]) -> BTreeMap<String, Spread> {
         ("degraded", column(|s| s.degraded as f64)),
         ("diverged", column(|s| s.diverged as f64)),
         ("silent", column(|s| s.silent as f64)),
+        ("acquired", column(|s| s.acquisitions.correct as f64)),
+        (
+            "false_accepts",
+            column(|s| s.acquisitions.false_accepts as f64),
+        ),
+        ("rejected", column(|s| s.acquisitions.rejected as f64)),
     ];
     columns
         .into_iter()

@@ -105,6 +105,13 @@ fn preamble(report: &TrackingReport) -> String {
 fn notes(report: &TrackingReport) -> String {
     let mut s = String::new();
     for (name, m) in &report.modes {
+        let a = m.acquisitions;
+        if a != Default::default() {
+            s += &format!(
+                "{name}: acquisitions: {} correct, {} false accepts, {} rejected; {} frames published tracking while far off\n",
+                a.correct, a.false_accepts, a.rejected, m.silent_frames
+            );
+        }
         if m.fallback_frames > 0 {
             s += &format!(
                 "{name}: {} frames fitted as deblur after CT-NDT stalled\n",
@@ -159,6 +166,7 @@ pub fn render_monte_carlo(r: &super::monte_carlo::MonteCarloReport) -> String {
         "lost",
         "diverged",
         "silent",
+        "acquired / false acc. / rejected",
     ]);
     for (name, m) in &r.modes {
         let st = |k: &str| m.stats.get(k).copied();
@@ -186,10 +194,26 @@ pub fn render_monte_carlo(r: &super::monte_carlo::MonteCarloReport) -> String {
             sum(|s| s.lost),
             sum(|s| s.diverged),
             sum(|s| s.silent),
+            format!(
+                "{} / {} / {}",
+                sum(|s| s.acquisitions.correct),
+                sum(|s| s.acquisitions.false_accepts),
+                sum(|s| s.acquisitions.rejected)
+            ),
         ]);
     }
+    let acquired = r
+        .modes
+        .values()
+        .flat_map(|m| &m.per_seed)
+        .any(|s| s.acquisitions != Default::default());
+    let start = if acquired {
+        "from init's acquisitions, no truth"
+    } else {
+        "from the truth with zero rates"
+    };
     format!(
-        "{} on {}: {} seeds ({}), {} frames each, whole runs from the truth with zero rates \
+        "{} on {}: {} seeds ({}), {} frames each, whole runs {start} \
          (start-up included; max* = after {} warm-up frames); errors in deg and cm\n",
         r.scenario,
         r.target,
@@ -223,6 +247,8 @@ mod tests {
             degraded_frames,
             diverged_frames: 0,
             fallback_frames,
+            acquisitions: Default::default(),
+            silent_frames: 0,
             frames: 100,
             series: Vec::new(),
         }

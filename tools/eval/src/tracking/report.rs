@@ -1,9 +1,11 @@
 //! What `spacepose eval tracking` measures: a record per frame and mode,
 //! scored against truth as in seed 000 Tables 2-3, and its summary.
 
+use super::acquisition::{AcquisitionCounts, AcquisitionRecord};
 use crate::stats::{MeanMax, median};
+use nalgebra::Rotation3;
 use serde::Serialize;
-use spacepose_geometry::Pose;
+use spacepose_geometry::{Pose, so3};
 use spacepose_lidar_sim::Frame;
 use spacepose_messages::{PoseEstimate, WireStatus};
 use spacepose_tracker::{TrackOutput, TrackStatus};
@@ -72,6 +74,10 @@ pub struct FrameRecord {
     /// `deblur` mode: fitted by CT-NDT in the start-up
     /// (`TrackerConfig::start_up_blur_deg`).
     pub start_up: bool,
+    /// The acquisition init published on this frame, when the suite
+    /// acquires (`--init acquire`); it applies from the next frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub acquisition: Option<AcquisitionRecord>,
 }
 
 /// Summary of one mode (the columns of seed 000 Tables 2-3).
@@ -99,6 +105,11 @@ pub struct ModeReport {
     pub diverged_frames: usize,
     /// Frames fitted by the stall fallback (`ct-ndt` mode).
     pub fallback_frames: usize,
+    /// Acquisitions by verdict (all zero from a truth start).
+    pub acquisitions: AcquisitionCounts,
+    /// Frames published `tracking` beyond the far-off bound: silent wrong
+    /// poses.
+    pub silent_frames: usize,
     /// Frames run.
     pub frames: usize,
     /// Per-frame records.
@@ -136,17 +147,27 @@ impl FrameRecord {
     pub fn far_off(&self) -> bool {
         !(self.ang_err_deg <= DIVERGED_DEG && self.pos_err_cm <= DIVERGED_M * 100.0)
     }
+
+    /// Published `tracking` while far off: a silent wrong pose.
+    pub fn silent(&self) -> bool {
+        self.status == TrackStatus::Tracking && self.far_off()
+    }
 }
 
 /// The record of frame `index`: the estimate the tracker published, scored
 /// against the frame's truth, with the registration's figures from its
 /// `TrackOutput` (absent when the cloud never reached the tracker).
 /// `blur_lag_deg` is left NaN for the caller to set.
+///
+/// `symmetries` is the target's group when the track may have started from
+/// a symmetric twin (an acquisition): the attitude error is then d_sym.
+/// Empty from a truth start, where a flip to a twin counts as an error.
 pub fn record(
     frame: &Frame,
     index: usize,
     estimate: &PoseEstimate,
     out: Option<&TrackOutput>,
+    symmetries: &[Rotation3<f64>],
 ) -> FrameRecord {
     let status = match estimate.wire_status() {
         Ok(WireStatus::Tracking) => TrackStatus::Tracking,
@@ -156,8 +177,12 @@ pub fn record(
     let pose = estimate.pose().ok().filter(|_| status != TrackStatus::Lost);
     let truth = &frame.truth;
     let (ang, pos) = pose.map_or((f64::NAN, f64::NAN), |p: Pose| {
-        let (a, d) = p.error_to(&truth.t_sensor_target);
-        (a.to_degrees(), d * 100.0)
+        let t = &truth.t_sensor_target;
+        let a = so3::distance_sym(&p.rotation, &t.rotation, symmetries);
+        (
+            a.to_degrees(),
+            (p.translation - t.translation).norm() * 100.0,
+        )
     });
     let w = out.map_or(nalgebra::Vector3::repeat(f64::NAN), |o| o.w_target);
     let w_err = w - truth.w_target;
@@ -186,6 +211,7 @@ pub fn record(
         blur_lag_deg: f64::NAN,
         fallback: out.is_some_and(|o| o.fallback),
         start_up: out.is_some_and(|o| o.start_up),
+        acquisition: None,
     }
 }
 
@@ -210,6 +236,8 @@ pub fn summarise(series: Vec<FrameRecord>, warmup: usize) -> ModeReport {
         degraded_frames: count(TrackStatus::Degraded),
         diverged_frames: diverged,
         fallback_frames: series.iter().filter(|r| r.fallback).count(),
+        acquisitions: AcquisitionCounts::of(series.iter().filter_map(|r| r.acquisition.as_ref())),
+        silent_frames: series.iter().filter(|r| r.silent()).count(),
         frames: series.len(),
         series,
     }
