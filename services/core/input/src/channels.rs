@@ -1,8 +1,9 @@
 //! The channels of MCAP files, and the choice of the point-cloud channel.
 
+use crate::bounded::BoundedMessages;
 use crate::error::InputError;
 use crate::{foxglove_cloud, pointcloud2};
-use mcap::read::{MessageStream, Options, Summary};
+use mcap::read::Summary;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -70,8 +71,7 @@ fn scan_channels(path: &Path, buf: &[u8]) -> Result<Vec<ChannelInfo>, InputError
         path: path.to_owned(),
         message: e.to_string(),
     };
-    let stream =
-        MessageStream::new_with_options(buf, Options::IgnoreEndMagic.into()).map_err(error)?;
+    let stream = BoundedMessages::new(buf);
     let mut seen: BTreeMap<u16, ChannelInfo> = BTreeMap::new();
     for message in stream {
         let message = match message {

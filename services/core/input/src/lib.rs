@@ -26,8 +26,10 @@
 //! layouts are [`InputError`] values, one per frame, and the reading goes on.
 #![forbid(unsafe_code)]
 
+mod bounded;
 mod cdr;
 pub mod channels;
+mod chunks;
 pub mod error;
 pub mod foxglove_cloud;
 pub mod frame;

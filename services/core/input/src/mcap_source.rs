@@ -5,7 +5,9 @@
 //! decoded one by one; for spacepose's own Foxglove clouds the JSON header
 //! on `<topic>/header` with the same log time is paired with its cloud.
 
+use crate::bounded::BoundedMessages;
 use crate::channels::{ChannelInfo, CloudKind, channels_of, choose};
+use crate::chunks::check_chunk_sizes;
 use crate::error::{CloudError, InputError};
 use crate::foxglove_cloud::{HEADER_TOPIC_SUFFIX, SpaceposeHeader, parse_header};
 use crate::frame::InputFrame;
@@ -13,7 +15,6 @@ use crate::options::InputOptions;
 use crate::pointcloud2::DecodedCloud;
 use crate::{foxglove_cloud, pointcloud2};
 use mcap::Message;
-use mcap::read::{MessageStream, Options};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -48,6 +49,7 @@ impl McapSource {
                 path: file.clone(),
                 source,
             })?;
+            check_chunk_sizes(file, &buf)?;
             channels.extend(channels_of(file, &buf)?);
             loaded.push((file.clone(), buf));
         }
@@ -121,7 +123,7 @@ struct Pending {
 pub struct McapFrames<'a> {
     source: &'a McapSource,
     file: usize,
-    stream: Option<MessageStream<'a>>,
+    stream: Option<BoundedMessages<'a>>,
     pending: Option<Pending>,
     headers: BTreeMap<u64, Result<SpaceposeHeader, CloudError>>,
     rank: u64,
@@ -174,12 +176,9 @@ impl McapFrames<'_> {
     fn next_message(&mut self) -> Option<Result<Message<'static>, InputError>> {
         loop {
             if self.stream.is_none() {
-                let (path, buf) = self.source.files.get(self.file)?;
+                let (_, buf) = self.source.files.get(self.file)?;
                 self.file += 1;
-                match MessageStream::new_with_options(buf, Options::IgnoreEndMagic.into()) {
-                    Ok(s) => self.stream = Some(s),
-                    Err(e) => return Some(Err(mcap_error(path, e))),
-                }
+                self.stream = Some(BoundedMessages::new(buf));
             }
             match self.stream.as_mut()?.next() {
                 Some(Ok(m)) => return Some(Ok(m)),

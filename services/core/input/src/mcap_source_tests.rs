@@ -230,3 +230,29 @@ fn a_bag_reads_its_split_files_in_order() {
             .contains("sqlite3")
     );
 }
+
+/// Seeded random corruption of a valid file: errors, never a panic.
+#[test]
+fn corrupted_files_are_errors_never_panics() {
+    use rand::{RngExt, SeedableRng};
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("run.mcap");
+    let entries: Vec<Entry> = (0..5)
+        .map(|k| ("/points", ROS, "cdr", k, ros_cloud(k as f32)))
+        .collect();
+    write_mcap(&path, &entries);
+    let valid = std::fs::read(&path).unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(26);
+    let bad = tmp.path().join("bad.mcap");
+    for _ in 0..300 {
+        let mut m = valid.clone();
+        for _ in 0..rng.random_range(1..4) {
+            let i = rng.random_range(8..m.len());
+            m[i] = rng.random();
+        }
+        std::fs::write(&bad, &m).unwrap();
+        if let Ok(mut rec) = open(&bad, &InputOptions::default()) {
+            assert!(rec.frames().count() <= 6);
+        }
+    }
+}

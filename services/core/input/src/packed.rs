@@ -86,7 +86,8 @@ pub(crate) fn unpack(
     let read = |point: &[u8], s: Slot| s.scalar.read_le(&point[s.offset..]).unwrap_or(f64::NAN);
     let mut points = Vec::with_capacity(layout.width as usize * layout.height as usize);
     let mut dropped = 0;
-    for row in 0..layout.height as usize {
+    let rows = if layout.width == 0 { 0 } else { layout.height };
+    for row in 0..rows as usize {
         let row_start = row * layout.row_step as usize;
         for col in 0..layout.width as usize {
             let start = row_start + col * layout.point_step as usize;

@@ -169,3 +169,31 @@ fn unsupported_and_inconsistent_layouts_are_errors() {
     narrow_row.row_step = 16;
     assert!(matches!(err(&narrow_row), CloudError::FieldType { .. }));
 }
+
+/// Seeded random corruption of valid messages: every outcome is a value
+/// (points or an error), never a panic or a runaway allocation.
+#[test]
+fn corrupted_messages_are_errors_or_points_never_panics() {
+    use rand::{RngExt, SeedableRng};
+    let t: Vec<Vec<u8>> = [0u32, 1, 2]
+        .iter()
+        .map(|t| t.to_le_bytes().to_vec())
+        .collect();
+    let valid = Cloud2::xyzi(&points(), Some(("offset_time", 6, &t))).to_cdr();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(26);
+    for _ in 0..5000 {
+        let mut m = valid.clone();
+        for _ in 0..rng.random_range(1..6) {
+            let i = rng.random_range(0..m.len());
+            m[i] = rng.random();
+        }
+        m.truncate(rng.random_range(0..=m.len()));
+        if let Ok(d) = decode(&m, &InputOptions::default()) {
+            assert!(d.points.len() <= m.len());
+        }
+    }
+    let mut empty_rows = Cloud2::xyzi(&[], None);
+    (empty_rows.height, empty_rows.width, empty_rows.row_step) = (u32::MAX, 0, 0);
+    let d = decode(&empty_rows.to_cdr(), &InputOptions::default()).unwrap();
+    assert!(d.points.is_empty());
+}
