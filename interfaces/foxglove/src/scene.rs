@@ -23,6 +23,19 @@ pub struct TargetMesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
+impl TargetMesh {
+    /// The mesh of `target`, in its body frame (the one conversion from a
+    /// target package).
+    pub fn of(target: &spacepose_model::Target) -> Self {
+        let mesh = target.mesh();
+        TargetMesh {
+            name: target.name().to_string(),
+            vertices: mesh.vertices().iter().map(|v| [v.x, v.y, v.z]).collect(),
+            triangles: mesh.triangles().to_vec(),
+        }
+    }
+}
+
 /// The scene holding the target at the estimated and at the true pose,
 /// stamped at sensor time `t_s`.
 pub fn target_scene(mesh: &TargetMesh, t_s: f64) -> SceneUpdate {

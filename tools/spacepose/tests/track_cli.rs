@@ -89,6 +89,24 @@ fn a_recording_is_tracked_from_an_acquisition_the_same_way_twice() {
     );
     assert_eq!(pa, pb, "two runs on the same recording differ");
     assert_eq!(String::from_utf8_lossy(&pa).lines().count(), 7);
+    // Recorded as MCAP, then tracked from that recording: the same poses.
+    let log = ok(&spacepose(
+        dir,
+        &["track", "--input", "frames", "--out", "run.mcap"],
+    ));
+    assert!(log.contains("written to run.mcap"), "{log}");
+    let replay = [
+        "track",
+        "--input",
+        "run.mcap",
+        "--topic",
+        "/spacepose/raw_cloud",
+        "--out",
+        "replay.csv",
+    ];
+    ok(&spacepose(dir, &replay));
+    let pr = std::fs::read(dir.join("replay.csv")).unwrap();
+    assert_eq!(pa, pr, "tracking the MCAP recording gives other poses");
 
     // No time field: derived times, said in the log, counted, still tracked.
     strip_times(&dir.join("frames"), &dir.join("no-times"));

@@ -28,12 +28,7 @@ pub fn free_path(path: &Path) -> PathBuf {
 pub fn target_mesh(spec: &str, scale: f64) -> anyhow::Result<TargetMesh> {
     let package = spacepose_prepare::resolve(spec, scale)
         .with_context(|| format!("target {spec:?} for the recorded scene"))?;
-    let mesh = package.target.mesh();
-    Ok(TargetMesh {
-        name: package.target.name().to_string(),
-        vertices: mesh.vertices().iter().map(|v| [v.x, v.y, v.z]).collect(),
-        triangles: mesh.triangles().to_vec(),
-    })
+    Ok(TargetMesh::of(&package.target))
 }
 
 /// Records the descriptor as the attachment `descriptor.toml`, and each

@@ -70,7 +70,9 @@ pub struct TrackArgs {
     /// Scale of a mesh file (file units → metres).
     #[arg(long, default_value_t = 1.0)]
     pub scale: f64,
-    /// Where the poses go, one row per frame (`.csv`).
+    /// Where the poses go: `.csv`, one row per frame, or `.mcap`, the run
+    /// as the suite's recorder writes it (clouds, poses, filter states,
+    /// acquisitions, the target model; Foxglove schemas).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// How the track starts: `acquire`, or a pose `px,py,pz,qw,qx,qy,qz`

@@ -11,6 +11,7 @@
 mod args;
 mod config;
 mod pose_csv;
+mod record;
 mod summary;
 mod truth;
 
@@ -22,6 +23,7 @@ pub use summary::{Errors, TrackSummary};
 use crate::common::progress_bar;
 use crate::tracking::DeployedSuite;
 use anyhow::{Context, Result, bail};
+use record::McapOut;
 use spacepose_input::InputFrame;
 use spacepose_messages::{AcquisitionMethod, AcquisitionResult, CloudHeader, Name};
 use summary::Scorer;
@@ -51,10 +53,24 @@ pub fn run(args: &TrackArgs) -> Result<()> {
         config.tracker.tracker.mode = mode;
     }
     config.validate()?;
-    let (summary, rows) = track(args, &config, package.target.symmetries())?;
-    if let Some(out) = &args.out {
-        pose_csv::write(out, &rows)?;
-        info!("poses written to {}", out.display());
+    let mut mcap = match args.out.as_deref() {
+        Some(out) if has_extension(out, "mcap") => Some(McapOut::create(out, &package.target)?),
+        Some(out) if !has_extension(out, "csv") => {
+            bail!(
+                "--out {}: the poses go to a .csv or .mcap file",
+                out.display()
+            )
+        }
+        _ => None,
+    };
+    let (summary, rows) = track(args, &config, package.target.symmetries(), mcap.as_mut())?;
+    match (args.out.as_deref(), mcap) {
+        (Some(out), Some(m)) => println!("{} written to {}", m.close()?, out.display()),
+        (Some(out), None) => {
+            pose_csv::write(out, &rows)?;
+            println!("poses written to {}", out.display());
+        }
+        _ => {}
     }
     print!("{}", summary.render());
     if let Some(path) = &args.json {
@@ -69,6 +85,7 @@ pub fn track(
     args: &TrackArgs,
     config: &TrackConfig,
     symmetries: &[nalgebra::Rotation3<f64>],
+    mut mcap: Option<&mut McapOut>,
 ) -> Result<(TrackSummary, Vec<PoseRow>)> {
     let mut recording = spacepose_input::open(&args.input, &config.input)
         .with_context(|| format!("--input {}", args.input.display()))?;
@@ -120,7 +137,13 @@ pub fn track(
         if let (0, InitChoice::Given(pose)) = (sequence, &args.init) {
             suite.acquire(given_acquisition(pose, &frame)?);
         }
-        let row = track_frame(&mut suite, &mut scorer, &frame, sequence)?;
+        let row = track_frame(
+            &mut suite,
+            &mut scorer,
+            &frame,
+            sequence,
+            mcap.as_deref_mut(),
+        )?;
         rows.push(row);
         sequence += 1;
         bar.inc(1);
@@ -138,12 +161,16 @@ fn track_frame(
     scorer: &mut Scorer<'_>,
     frame: &InputFrame,
     sequence: u64,
+    mcap: Option<&mut McapOut>,
 ) -> Result<PoseRow> {
     if frame.times_derived() {
         scorer.summary_mut().frames_derived_times += 1;
     }
     let header = CloudHeader::new(sequence, frame.scan_start_s, frame.scan_end_s);
     let answer = suite.track(header, frame.points.clone())?;
+    if let Some(m) = mcap {
+        m.frame(&header, &frame.points, &answer.sent)?;
+    }
     let status = pose_csv::status_name(&answer.estimate);
     scorer.frame(frame.index, &answer.estimate, status);
     let mut acquired = "";
@@ -160,6 +187,11 @@ fn track_frame(
         estimate: answer.estimate,
         acquired,
     })
+}
+
+fn has_extension(path: &std::path::Path, ext: &str) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case(ext))
 }
 
 /// The operator's pose as an accepted acquisition of the first frame.

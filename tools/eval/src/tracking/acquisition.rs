@@ -3,7 +3,7 @@
 //! [`DIVERGED_M`]). An accepted pose beyond it hands the tracker a wrong
 //! start: a false accept.
 
-use super::report::{DIVERGED_DEG, DIVERGED_M};
+use super::bounds::{DIVERGED_DEG, DIVERGED_M};
 use nalgebra::Rotation3;
 use serde::Serialize;
 use spacepose_geometry::{Pose, so3};

@@ -50,6 +50,10 @@ pub struct Answer {
     /// Acquisitions init published on this frame (accepted or not), with
     /// [`DeployedSuite::with_init`]; they apply from the next frame on.
     pub acquisitions: Vec<AcquisitionResult>,
+    /// Everything the nodes published for this frame, in order (the
+    /// cropped cloud, the estimate, the filter state, acquisitions), for a
+    /// recording.
+    pub sent: Vec<Envelope>,
 }
 
 /// Ingest, tracker and filter (and init) on one in-memory bus.
@@ -143,6 +147,7 @@ impl DeployedSuite {
             estimate,
             output,
             acquisitions,
+            sent,
         })
     }
 

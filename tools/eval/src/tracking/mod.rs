@@ -23,6 +23,7 @@
 
 pub mod acquisition;
 mod args;
+pub mod bounds;
 pub mod deployed;
 pub mod frames;
 pub mod monte_carlo;

@@ -11,11 +11,7 @@ use spacepose_messages::{PoseEstimate, WireStatus};
 use spacepose_tracker::{TrackOutput, TrackStatus};
 use std::collections::BTreeMap;
 
-/// A frame whose error exceeds these has lost the target in truth, whatever
-/// the tracker reports.
-pub const DIVERGED_DEG: f64 = 10.0;
-/// See [`DIVERGED_DEG`] (m).
-pub const DIVERGED_M: f64 = 0.5;
+pub use super::bounds::{DIVERGED_DEG, DIVERGED_M};
 
 /// One frame of one mode.
 #[derive(Debug, Clone, Serialize)]
