@@ -236,6 +236,9 @@ pub fn python_with(name: &str, packages: &[&str], check: &str) -> Result<PathBuf
     if usable(&python) {
         Ok(python)
     } else {
-        Err(format!("`{check}` fails after installing {}", packages.join(" ")))
+        Err(format!(
+            "`{check}` fails after installing {}",
+            packages.join(" ")
+        ))
     }
 }
