@@ -91,7 +91,13 @@ fn scan_channels(path: &Path, buf: &[u8]) -> Result<Vec<ChannelInfo>, InputError
     Ok(seen.into_values().collect())
 }
 
-/// Chooses the point-cloud channel: `topic` if given, else the only one.
+/// The raw clouds of a spacepose recording (`spacepose-foxglove` writes the
+/// cropped ones beside them on `/spacepose/cloud`).
+pub const SPACEPOSE_RAW_CLOUD: &str = "/spacepose/raw_cloud";
+
+/// Chooses the point-cloud channel: `topic` if given, else the only one,
+/// else, in a spacepose recording, its raw clouds ([`SPACEPOSE_RAW_CLOUD`]:
+/// what the sensor gave, the input of the pipeline).
 ///
 /// # Errors
 /// [`InputError::Topic`] listing the point-cloud topics.
@@ -129,6 +135,11 @@ pub(crate) fn choose(
         },
         None => match clouds.as_slice() {
             [(t, kind, _)] => Ok(((*t).to_owned(), *kind)),
+            several if several.iter().any(|(t, _, _)| *t == SPACEPOSE_RAW_CLOUD) => several
+                .iter()
+                .find(|(t, _, _)| *t == SPACEPOSE_RAW_CLOUD)
+                .map(|&(t, kind, _)| (t.to_owned(), kind))
+                .ok_or_else(|| fail("no raw clouds".into())),
             [] => Err(fail("no point-cloud channel (sensor_msgs/msg/PointCloud2 in CDR, or foxglove.PointCloud)".into())),
             _ => Err(fail("several point-cloud channels: choose one with the topic option".into())),
         },
