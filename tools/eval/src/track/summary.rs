@@ -1,8 +1,8 @@
 //! What `spacepose track` tells at the end: frame counts by status, every
 //! acquisition, timings and, when the recording has truth, the errors.
 //!
-//! Scoring uses the eval's one far-off bound
-//! ([`DIVERGED_DEG`] / [`DIVERGED_M`]): a frame published `tracking` that
+//! Scoring uses the eval's one error and far-off bound
+//! ([`crate::tracking::bounds`]): a frame published `tracking` that
 //! far from the truth is a silent wrong pose, and an accepted acquisition
 //! that far is a false accept (the tracker starts from it). Attitudes are
 //! compared with d_sym over the target's symmetries: an acquisition may
@@ -11,10 +11,10 @@
 use super::truth::TruthPoses;
 use crate::stats::MeanMax;
 use crate::tracking::acquisition::{self, AcquisitionCounts, AcquisitionRecord};
-use crate::tracking::report::{DIVERGED_DEG, DIVERGED_M};
+use crate::tracking::bounds::{far_off, pose_error};
 use nalgebra::Rotation3;
 use serde::Serialize;
-use spacepose_geometry::{Pose, so3};
+use spacepose_geometry::Pose;
 use spacepose_messages::{AcquisitionResult, PoseEstimate};
 
 /// The run's summary.
@@ -86,11 +86,7 @@ impl<'a> Scorer<'a> {
 
     fn error(&self, frame: u64, pose: &Pose) -> Option<(f64, f64)> {
         let truth = self.truth?.get(&frame)?;
-        let ang = so3::distance_sym(&pose.rotation, &truth.rotation, self.symmetries);
-        Some((
-            ang.to_degrees(),
-            (pose.translation - truth.translation).norm(),
-        ))
+        Some(pose_error(pose, truth, self.symmetries))
     }
 
     /// One frame's estimate.
@@ -112,7 +108,7 @@ impl<'a> Scorer<'a> {
         self.pos.push(pos * 100.0);
         let errors = self.summary.errors.get_or_insert_with(Errors::default);
         errors.frames_scored += 1;
-        if status == "tracking" && (ang > DIVERGED_DEG || pos > DIVERGED_M) {
+        if status == "tracking" && far_off(ang, pos) {
             errors.silent_far_off += 1;
         }
     }

@@ -1,12 +1,12 @@
 //! An acquisition scored against the truth: correct, false accept or
-//! rejected, with the eval's one far-off bound ([`DIVERGED_DEG`] /
-//! [`DIVERGED_M`]). An accepted pose beyond it hands the tracker a wrong
+//! rejected, with the eval's one far-off bound
+//! ([`super::bounds::far_off`]). An accepted pose beyond it hands the tracker a wrong
 //! start: a false accept.
 
-use super::bounds::{DIVERGED_DEG, DIVERGED_M};
+use super::bounds::{far_off, pose_error};
 use nalgebra::Rotation3;
 use serde::Serialize;
-use spacepose_geometry::{Pose, so3};
+use spacepose_geometry::Pose;
 use spacepose_messages::{AcquisitionMethod, AcquisitionResult};
 
 /// One acquisition init published.
@@ -67,15 +67,14 @@ pub fn score(
     symmetries: &[Rotation3<f64>],
 ) -> AcquisitionRecord {
     let accepted = a.success == 1;
-    let error = truth.zip(a.pose().ok()).map(|(t, p)| {
-        let ang = so3::distance_sym(&p.rotation, &t.rotation, symmetries).to_degrees();
-        (ang, (p.translation - t.translation).norm())
-    });
+    let error = truth
+        .zip(a.pose().ok())
+        .map(|(t, p)| pose_error(&p, t, symmetries));
     let verdict = match (accepted, error) {
         (false, _) => "rejected",
         (true, None) => "unscored",
-        (true, Some((ang, pos))) if ang <= DIVERGED_DEG && pos <= DIVERGED_M => "correct",
-        (true, Some(_)) => "false-accept",
+        (true, Some((ang, pos))) if far_off(ang, pos) => "false-accept",
+        (true, Some(_)) => "correct",
     };
     AcquisitionRecord {
         frame,

@@ -5,13 +5,14 @@ use super::acquisition::{AcquisitionCounts, AcquisitionRecord};
 use crate::stats::{MeanMax, median};
 use nalgebra::Rotation3;
 use serde::Serialize;
-use spacepose_geometry::{Pose, so3};
+use spacepose_geometry::Pose;
 use spacepose_lidar_sim::Frame;
 use spacepose_messages::{PoseEstimate, WireStatus};
 use spacepose_tracker::{TrackOutput, TrackStatus};
 use std::collections::BTreeMap;
 
 pub use super::bounds::{DIVERGED_DEG, DIVERGED_M};
+use super::bounds::{far_off, pose_error};
 
 /// One frame of one mode.
 #[derive(Debug, Clone, Serialize)]
@@ -141,7 +142,7 @@ impl FrameRecord {
     /// More than [`DIVERGED_DEG`] or [`DIVERGED_M`] off in truth; a frame
     /// without a pose (NaN errors) counts.
     pub fn far_off(&self) -> bool {
-        !(self.ang_err_deg <= DIVERGED_DEG && self.pos_err_cm <= DIVERGED_M * 100.0)
+        far_off(self.ang_err_deg, self.pos_err_cm / 100.0)
     }
 
     /// Published `tracking` while far off: a silent wrong pose.
@@ -173,12 +174,8 @@ pub fn record(
     let pose = estimate.pose().ok().filter(|_| status != TrackStatus::Lost);
     let truth = &frame.truth;
     let (ang, pos) = pose.map_or((f64::NAN, f64::NAN), |p: Pose| {
-        let t = &truth.t_sensor_target;
-        let a = so3::distance_sym(&p.rotation, &t.rotation, symmetries);
-        (
-            a.to_degrees(),
-            (p.translation - t.translation).norm() * 100.0,
-        )
+        let (a, d) = pose_error(&p, &truth.t_sensor_target, symmetries);
+        (a, d * 100.0)
     });
     let w = out.map_or(nalgebra::Vector3::repeat(f64::NAN), |o| o.w_target);
     let w_err = w - truth.w_target;
