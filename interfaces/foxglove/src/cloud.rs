@@ -29,8 +29,26 @@ const FIELDS: [(&str, u32, NumericType); 5] = [
 
 /// The `foxglove.PointCloud` of a frame's points, stamped `scan_end_s`.
 pub fn point_cloud(points: &[Point], scan_end_s: f64) -> PointCloud {
-    let mut data = Vec::with_capacity(points.len() * POINT_STRIDE as usize);
-    for p in points {
+    point_cloud_every(points, 1, scan_end_s)
+}
+
+/// The step that keeps at most `max_points` of `n` points when every
+/// step-th point is kept (from the first); `max_points = 0`: no budget (1).
+pub fn point_step(n: usize, max_points: usize) -> usize {
+    if max_points == 0 || n <= max_points {
+        1
+    } else {
+        n.div_ceil(max_points)
+    }
+}
+
+/// The `foxglove.PointCloud` of every `step`-th point of a frame (from the
+/// first; a step of 0 counts as 1), in the layout of [`point_cloud`].
+pub fn point_cloud_every(points: &[Point], step: usize, scan_end_s: f64) -> PointCloud {
+    let step = step.max(1);
+    let kept = points.len().div_ceil(step);
+    let mut data = Vec::with_capacity(kept * POINT_STRIDE as usize);
+    for p in points.iter().step_by(step) {
         for f in [p.x, p.y, p.z, p.intensity] {
             data.extend_from_slice(&f.to_le_bytes());
         }
@@ -65,7 +83,9 @@ pub struct CloudHeaderRecord {
     pub scan_end_s: f64,
     /// Sensor identifier.
     pub sensor_id: u16,
-    /// Points in the frame (all recorded: clouds are decimated by frame, never by point).
+    /// Points in the cloud logged beside it: all the frame's points in a
+    /// recording (decimated by frame, never by point), fewer on the live
+    /// link when a point budget applies.
     pub point_count: u32,
     /// CLOCK_REALTIME when the frame was published (ns since the Unix epoch).
     pub published_ns: i64,
@@ -134,6 +154,32 @@ mod tests {
         }
         let ts = back.timestamp.unwrap();
         assert_eq!((ts.sec(), ts.nsec()), (1_000, 200_000_000));
+    }
+
+    #[test]
+    fn a_point_budget_keeps_every_kth_point() {
+        let points: Vec<Point> = (0..10)
+            .map(|i| Point::new(i as f32, 0.0, 1.0, 0.0, 0.0))
+            .collect();
+        assert_eq!(point_step(10, 0), 1);
+        assert_eq!(point_step(10, 10), 1);
+        assert_eq!(point_step(10, 4), 3);
+        assert_eq!(point_step(10_001, 2_000), 6);
+        for n in [1usize, 7, 4_799, 4_800, 4_801, 100_000] {
+            for max in [1, 3, 2_000] {
+                let kept = n.div_ceil(point_step(n, max));
+                assert!(kept <= max && kept >= max.min(n) / 2, "{n} {max} {kept}");
+            }
+        }
+        let cloud = point_cloud_every(&points, 3, 1.0);
+        let xs: Vec<f32> = (0..cloud.data.len() / 24)
+            .map(|i| read_f32(&cloud.data, 24 * i))
+            .collect();
+        assert_eq!(xs, [0.0, 3.0, 6.0, 9.0]);
+        assert_eq!(
+            point_cloud_every(&points, 0, 1.0),
+            point_cloud(&points, 1.0)
+        );
     }
 
     #[test]

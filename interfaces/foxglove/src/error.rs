@@ -1,4 +1,4 @@
-//! Errors of the conversions and of the recorder.
+//! Errors of the conversions, of the recorder and of the live view.
 
 /// What went wrong while recording.
 #[derive(Debug, thiserror::Error)]
@@ -17,6 +17,15 @@ pub enum RecordError {
     Channel {
         /// The channel's topic.
         topic: String,
+        /// The SDK's error.
+        #[source]
+        source: foxglove::FoxgloveError,
+    },
+    /// The live view's WebSocket server could not start.
+    #[error("live view on {addr}: {source}")]
+    Server {
+        /// The address it was to listen on.
+        addr: String,
         /// The SDK's error.
         #[source]
         source: foxglove::FoxgloveError,

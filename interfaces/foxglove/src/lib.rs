@@ -1,5 +1,6 @@
-//! The suite's messages as Foxglove well-known schemas, and an MCAP
-//! recorder of a run over the `foxglove` SDK.
+//! The suite's messages as Foxglove well-known schemas: an MCAP recorder
+//! of a run and a live view (a Foxglove WebSocket server) over the
+//! `foxglove` SDK.
 //!
 //! There is one conversion per message: clouds to `foxglove.PointCloud`
 //! ([`cloud`]), poses, truth and filter states to `foxglove.PoseInFrame`
@@ -10,8 +11,11 @@
 //!
 //! Log times are the sensor clock ([`stamp`]): a message is logged at the
 //! time of validity of its frame, so a recording sorts the same way however
-//! the processes were scheduled. The [`Recorder`] owns its own SDK context,
-//! so two recorders in one process never share channels. Topics and frames
+//! the processes were scheduled. The [`Recorder`] and the [`LiveView`] log
+//! through the same channel logger, so a file and the live link carry the
+//! same channels; the live view decimates clouds for the link (frames and
+//! a point budget) and adds the trajectory. Each owns its own SDK context,
+//! so two of them in one process never share channels. Topics and frames
 //! are in [`topics`] and `docs/recording.md`.
 #![forbid(unsafe_code)]
 
@@ -19,6 +23,8 @@ mod channels;
 pub mod cloud;
 pub mod error;
 pub mod json;
+pub mod live;
+mod log;
 pub mod pose;
 pub mod recorder;
 pub mod records;
@@ -28,6 +34,7 @@ pub mod topics;
 
 pub use cloud::{CloudHeaderRecord, POINT_STRIDE, point_cloud};
 pub use error::RecordError;
+pub use live::{LiveOptions, LiveStats, LiveView};
 pub use recorder::{Compression, RecordOptions, Recorder};
 pub use records::AcquisitionRecord;
 pub use scene::{TargetMesh, target_scene};

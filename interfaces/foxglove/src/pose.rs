@@ -7,7 +7,7 @@
 
 use crate::stamp::timestamp;
 use crate::topics::SENSOR_FRAME;
-use foxglove::messages::{FrameTransform, Pose, PoseInFrame, Quaternion, Vector3};
+use foxglove::messages::{FrameTransform, Pose, PoseInFrame, PosesInFrame, Quaternion, Vector3};
 
 /// A rigid pose `t_sensor_target` at sensor time `t_s` (s).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,6 +46,24 @@ impl SensorPose {
             translation: Some(vector(self.p_sensor_target)),
             rotation: Some(quaternion(self.q_sensor_target)),
         }
+    }
+}
+
+/// A trajectory: `poses` (oldest first) in frame `sensor`, stamped at the
+/// newest pose's time (0 s when there is none).
+pub fn poses_in_frame<'a>(poses: impl IntoIterator<Item = &'a SensorPose>) -> PosesInFrame {
+    let mut t_s = 0.0;
+    let poses = poses
+        .into_iter()
+        .map(|p| {
+            t_s = p.t_s;
+            p.pose()
+        })
+        .collect();
+    PosesInFrame {
+        timestamp: Some(timestamp(t_s)),
+        frame_id: SENSOR_FRAME.to_string(),
+        poses,
     }
 }
 
@@ -108,6 +126,21 @@ mod tests {
         let back = T::decode(buf.as_slice()).unwrap();
         assert_eq!(&back, m);
         back
+    }
+
+    #[test]
+    fn a_trajectory_is_stamped_at_its_newest_pose() {
+        let at = |t_s: f64| SensorPose {
+            t_s,
+            q_sensor_target: [1.0, 0.0, 0.0, 0.0],
+            p_sensor_target: [0.0, 0.0, t_s],
+        };
+        let track = round_trip(&poses_in_frame(&[at(1.0), at(1.5)]));
+        assert_eq!(track.frame_id, "sensor");
+        assert_eq!(track.timestamp.unwrap().total_nanos(), 1_500_000_000);
+        let z: Vec<f64> = track.poses.iter().map(|p| p.position.unwrap().z).collect();
+        assert_eq!(z, [1.0, 1.5]);
+        assert!(poses_in_frame(&[]).poses.is_empty());
     }
 
     #[test]

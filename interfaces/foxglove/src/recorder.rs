@@ -1,19 +1,10 @@
 //! [`Recorder`]: the suite's messages and clouds into one MCAP file.
 
-use crate::channels::Channels;
-use crate::cloud::{CloudHeaderRecord, point_cloud};
+use crate::cloud::point_cloud;
 use crate::error::RecordError;
-use crate::pose::SensorPose;
-use crate::records::AcquisitionRecord;
-use crate::scene::{TargetMesh, target_scene};
-use crate::stamp::log_time_ns;
-use crate::topics::{TARGET_FRAME, TARGET_TRUTH_FRAME};
-use foxglove::{
-    Context, McapAttachment, McapCompression, McapWriteOptions, McapWriterHandle, PartialMetadata,
-};
-use spacepose_messages::telemetry::{
-    TelemetryFilter, TelemetryHealth, TelemetryPose, TelemetryTruth,
-};
+use crate::log::{Logger, keeps_frame};
+use crate::scene::TargetMesh;
+use foxglove::{Context, McapAttachment, McapCompression, McapWriteOptions, McapWriterHandle};
 use spacepose_messages::{Cloud, Message, Topic};
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -73,13 +64,9 @@ pub struct Recorder {
     path: String,
     options: RecordOptions,
     writer: McapWriterHandle<BufWriter<File>>,
-    channels: Channels,
+    log: Logger,
     /// Keeps the channels' context alive for the writer's lifetime.
     _context: Arc<Context>,
-    /// Newest sensor time recorded (ns): the log time of heartbeats.
-    newest_ns: u64,
-    /// The target mesh, until it is sent with the first message.
-    pending_scene: Option<TargetMesh>,
     stats: RecordStats,
 }
 
@@ -104,15 +91,13 @@ impl Recorder {
             .mcap_writer_with_options(McapWriteOptions::new().compression(compression))
             .create_new_buffered_file(path)
             .map_err(file_err)?;
-        let channels = Channels::new(&context)?;
+        let log = Logger::new(&context)?;
         Ok(Self {
             path: path_str,
             options,
             writer,
-            channels,
+            log,
             _context: context,
-            newest_ns: 0,
-            pending_scene: None,
             stats: RecordStats::default(),
         })
     }
@@ -120,24 +105,12 @@ impl Recorder {
     /// The target model, placed at the estimated and true poses: sent once,
     /// at the log time of the next message recorded.
     pub fn set_target(&mut self, mesh: TargetMesh) {
-        self.pending_scene = Some(mesh);
+        self.log.set_target(mesh);
     }
 
     /// What was recorded so far.
     pub fn stats(&self) -> RecordStats {
         self.stats
-    }
-
-    /// Advances the newest sensor time and sends the pending scene.
-    fn at(&mut self, log_ns: u64) -> u64 {
-        self.newest_ns = self.newest_ns.max(log_ns);
-        if let Some(mesh) = self.pending_scene.take() {
-            let scene = target_scene(&mesh, log_ns as f64 * 1e-9);
-            self.channels
-                .scene
-                .log_with_meta(&scene, PartialMetadata::with_log_time(log_ns));
-        }
-        log_ns
     }
 
     /// Records a cloud (raw or cropped) and its header at the scan end,
@@ -146,28 +119,17 @@ impl Recorder {
     /// # Errors
     /// The header could not be written as JSON.
     pub fn cloud(&mut self, cloud: Cloud<'_>) -> Result<bool, RecordError> {
-        let raw = cloud.topic == Topic::RawCloud;
-        let every = if raw {
+        let every = if cloud.topic == Topic::RawCloud {
             self.options.raw_cloud_every
         } else {
             self.options.cloud_every
         };
-        if every == 0 || !cloud.header.sequence.is_multiple_of(every) {
+        if !keeps_frame(every, cloud.header.sequence) {
             self.stats.clouds_skipped += 1;
             return Ok(false);
         }
-        let t = self.at(log_time_ns(cloud.header.scan_end_s));
         let message = point_cloud(cloud.points, cloud.header.scan_end_s);
-        let header = CloudHeaderRecord::new(cloud.header, cloud.points.len());
-        let meta = PartialMetadata::with_log_time(t);
-        let ch = &self.channels;
-        let (points, header_ch) = if raw {
-            (&ch.raw_cloud, &ch.raw_cloud_header)
-        } else {
-            (&ch.cloud, &ch.cloud_header)
-        };
-        points.log_with_meta(&message, meta);
-        header_ch.log(&header, t)?;
+        self.log.cloud(&cloud, &message, cloud.points.len())?;
         self.stats.clouds += 1;
         Ok(true)
     }
@@ -177,69 +139,10 @@ impl Recorder {
     /// # Errors
     /// A message with unknown codes or a degenerate rotation.
     pub fn message(&mut self, msg: &Message) -> Result<(), RecordError> {
-        match msg {
-            Message::Pose(m) => self.pose(m)?,
-            Message::FilterState(m) => self.filter_state(m)?,
-            Message::Acquisition(m) => {
-                let record = AcquisitionRecord::from_wire(m)?;
-                let t = self.at(log_time_ns(m.t_s));
-                self.channels.acquisition.log(&record, t)?;
-            }
-            Message::Truth(m) => self.truth(m)?,
-            Message::Health(m) => {
-                let record = TelemetryHealth::from_wire(m)?;
-                let t = self.at(self.newest_ns);
-                self.channels.health.log(&record, t)?;
-            }
-            Message::Command(_) => return Ok(()),
+        if self.log.message(msg)? {
+            self.stats.messages += 1;
         }
-        self.stats.messages += 1;
         Ok(())
-    }
-
-    fn pose(&mut self, m: &spacepose_messages::PoseEstimate) -> Result<(), RecordError> {
-        let record = TelemetryPose::from_wire(m)?;
-        let t = self.at(log_time_ns(m.t_s));
-        let pose = SensorPose::from(m);
-        let meta = PartialMetadata::with_log_time(t);
-        self.channels
-            .pose
-            .log_with_meta(&pose.pose_in_frame(), meta);
-        self.channels
-            .pose_tf
-            .log_with_meta(&pose.transform_to(TARGET_FRAME), meta);
-        self.channels.pose_estimate.log(&record, t)
-    }
-
-    fn filter_state(&mut self, m: &spacepose_messages::FilterState) -> Result<(), RecordError> {
-        let record = TelemetryFilter::from_wire(m)?;
-        let initialized = m.initialized == 1;
-        let t = self.at(if initialized {
-            log_time_ns(m.t_s)
-        } else {
-            self.newest_ns
-        });
-        if initialized {
-            let pose = SensorPose::from(m).pose_in_frame();
-            self.channels
-                .filter_pose
-                .log_with_meta(&pose, PartialMetadata::with_log_time(t));
-        }
-        self.channels.filter_state.log(&record, t)
-    }
-
-    fn truth(&mut self, m: &spacepose_messages::TruthMsg) -> Result<(), RecordError> {
-        let record = TelemetryTruth::from_wire(m)?;
-        let t = self.at(log_time_ns(m.t_s));
-        let pose = SensorPose::from(m);
-        let meta = PartialMetadata::with_log_time(t);
-        self.channels
-            .truth
-            .log_with_meta(&pose.pose_in_frame(), meta);
-        self.channels
-            .truth_tf
-            .log_with_meta(&pose.transform_to(TARGET_TRUTH_FRAME), meta);
-        self.channels.truth_state.log(&record, t)
     }
 
     /// Writes an MCAP metadata record `name` (skipped when `entries` is empty).
@@ -262,8 +165,8 @@ impl Recorder {
     /// The file could not be written.
     pub fn attach(&self, name: &str, media_type: &str, data: &[u8]) -> Result<(), RecordError> {
         let attachment = McapAttachment {
-            log_time: self.newest_ns,
-            create_time: self.newest_ns,
+            log_time: self.log.newest_ns(),
+            create_time: self.log.newest_ns(),
             name: name.to_string(),
             media_type: media_type.to_string(),
             data: std::borrow::Cow::Borrowed(data),

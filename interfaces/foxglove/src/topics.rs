@@ -16,6 +16,9 @@ pub const CLOUD_HEADER: &str = "/spacepose/cloud/header";
 pub const POSE: &str = "/spacepose/pose";
 /// Pose estimates with status and quality (JSON `TelemetryPose`).
 pub const POSE_ESTIMATE: &str = "/spacepose/pose/estimate";
+/// The last estimates, oldest first (`foxglove.PosesInFrame`, frame
+/// `sensor`): live view only.
+pub const TRAJECTORY: &str = "/spacepose/pose/trajectory";
 /// `sensor -> target` at each estimate (`foxglove.FrameTransform`).
 pub const POSE_TF: &str = "/spacepose/pose/tf";
 /// Filter states (JSON `TelemetryFilter`).
