@@ -1,5 +1,7 @@
-//! Configuration of the recorder service (TOML; keys in `README.md`).
+//! Configuration of the recorder service (TOML; keys in `README.md` and
+//! `deploy/examples/recorder.toml`).
 
+use crate::live_config::LiveConfig;
 use serde::{Deserialize, Serialize};
 use spacepose_foxglove::{Compression, RecordOptions};
 use spacepose_runtime::ServiceConfig;
@@ -9,9 +11,10 @@ use std::path::PathBuf;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RecorderConfig {
-    /// The MCAP file to write. When it exists (a restarted recorder), the
-    /// recording goes on in `<stem>.1.mcap`, `<stem>.2.mcap`, ...
-    pub file: PathBuf,
+    /// The MCAP file to write; `None`: no file (a live view only). When it
+    /// exists (a restarted recorder), the recording goes on in
+    /// `<stem>.1.mcap`, `<stem>.2.mcap`, ...
+    pub file: Option<PathBuf>,
     /// Chunk compression: `"lz4"` (default), `"zstd"` or `"none"`.
     pub compression: Compression,
     /// Record the raw cloud of every n-th frame (by sequence); 0: none.
@@ -30,12 +33,14 @@ pub struct RecorderConfig {
     /// Scheduling niceness of the recorder (0-19): the recorder is off the
     /// frame path, so it yields the CPU to the services on it.
     pub nice: i32,
+    /// The live view (a Foxglove WebSocket server); `None`: none.
+    pub live: Option<LiveConfig>,
 }
 
 impl Default for RecorderConfig {
     fn default() -> Self {
         Self {
-            file: PathBuf::from("run.mcap"),
+            file: None,
             compression: Compression::Lz4,
             raw_cloud_every: 1,
             cloud_every: 1,
@@ -43,6 +48,7 @@ impl Default for RecorderConfig {
             target_scale: 1.0,
             descriptor: String::new(),
             nice: 10,
+            live: None,
         }
     }
 }
@@ -60,11 +66,18 @@ impl RecorderConfig {
 
 impl ServiceConfig for RecorderConfig {
     fn validate(&self) -> Result<(), String> {
-        if self.file.as_os_str().is_empty() {
-            return Err("file must not be empty".into());
+        match &self.file {
+            None if self.live.is_none() => {
+                return Err("neither a file nor a [live] view: nothing to do".into());
+            }
+            None => {}
+            Some(f) if f.extension().is_none_or(|e| e != "mcap") => {
+                return Err(format!("file {} must end in .mcap", f.display()));
+            }
+            Some(_) => {}
         }
-        if self.file.extension().is_none_or(|e| e != "mcap") {
-            return Err(format!("file {} must end in .mcap", self.file.display()));
+        if let Some(live) = &self.live {
+            live.validate().map_err(|e| format!("[live] {e}"))?;
         }
         if !(self.target_scale.is_finite() && self.target_scale > 0.0) {
             return Err(format!("target_scale = {} must be > 0", self.target_scale));
@@ -84,9 +97,40 @@ impl ServiceConfig for RecorderConfig {
 mod tests {
     use super::*;
 
+    fn valid() -> RecorderConfig {
+        RecorderConfig {
+            file: Some("run.mcap".into()),
+            ..RecorderConfig::default()
+        }
+    }
+
+    /// `deploy/examples/recorder.toml` parses, validates and shows the
+    /// defaults (but for the file and the live view it spells out).
     #[test]
-    fn defaults_are_valid_and_bad_values_are_named() {
-        assert_eq!(RecorderConfig::default().validate(), Ok(()));
+    fn the_deploy_example_parses_and_shows_the_defaults() {
+        let text = include_str!(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../../deploy/examples/recorder.toml"
+        ));
+        let c: RecorderConfig = toml::from_str(text).unwrap();
+        c.validate().unwrap();
+        assert_eq!(c.live, Some(LiveConfig::default()));
+        let defaults = RecorderConfig {
+            file: c.file.clone(),
+            live: c.live.clone(),
+            ..RecorderConfig::default()
+        };
+        assert_eq!(c, defaults);
+    }
+
+    #[test]
+    fn a_file_or_a_live_view_is_needed_and_bad_values_are_named() {
+        assert_eq!(valid().validate(), Ok(()));
+        let e = RecorderConfig::default().validate().unwrap_err();
+        assert!(e.contains("file") && e.contains("live"), "{e}");
+        let live_only: RecorderConfig = toml::from_str("[live]\n").unwrap();
+        assert_eq!(live_only.validate(), Ok(()));
+        assert_eq!(live_only.file, None);
         let c: RecorderConfig =
             toml::from_str("file = \"/tmp/a.mcap\"\ncompression = \"zstd\"\ncloud_every = 5\n")
                 .unwrap();
@@ -99,23 +143,27 @@ mod tests {
             (
                 RecorderConfig {
                     target_scale: f64::NAN,
-                    ..RecorderConfig::default()
+                    ..valid()
                 },
                 "target_scale",
             ),
             (
                 RecorderConfig {
-                    file: "a.bag".into(),
-                    ..RecorderConfig::default()
+                    file: Some("a.bag".into()),
+                    ..valid()
                 },
                 "file",
             ),
             (
                 RecorderConfig {
                     descriptor: "x = = 1".into(),
-                    ..RecorderConfig::default()
+                    ..valid()
                 },
                 "descriptor",
+            ),
+            (
+                toml::from_str("[live]\nlisten = \"0.0.0.0:8765\"\n").unwrap(),
+                "[live] listen",
             ),
         ] {
             let e = bad.validate().unwrap_err();
@@ -123,5 +171,6 @@ mod tests {
         }
         assert!(toml::from_str::<RecorderConfig>("every = 2\n").is_err());
         assert!(toml::from_str::<RecorderConfig>("compression = \"gzip\"\n").is_err());
+        assert!(toml::from_str::<RecorderConfig>("[live]\nport = 1\n").is_err());
     }
 }

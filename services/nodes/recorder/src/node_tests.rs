@@ -26,7 +26,7 @@ fn a_run_is_recorded_with_its_configuration_and_closed_on_stop() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("run.mcap");
     let config = RecorderConfig {
-        file: file.clone(),
+        file: Some(file.clone()),
         descriptor: DESCRIPTOR.into(),
         ..RecorderConfig::default()
     };
@@ -88,10 +88,45 @@ fn a_run_is_recorded_with_its_configuration_and_closed_on_stop() {
     assert_eq!(&attachment.data[..], DESCRIPTOR.as_bytes());
     // A restarted recorder starts a new part beside the first.
     let config = RecorderConfig {
-        file,
+        file: Some(file),
         target: String::new(),
         ..RecorderConfig::default()
     };
     drop(RecorderNode::new(config, &info()).unwrap());
     assert!(dir.path().join("run.1.mcap").is_file());
+}
+
+#[test]
+fn a_live_only_recorder_streams_without_a_file() {
+    let live: LiveConfig = toml::from_str("listen = \"127.0.0.1:0\"\nmax_points = 2\n").unwrap();
+    let config = RecorderConfig {
+        live: Some(live),
+        target: String::new(),
+        ..RecorderConfig::default()
+    };
+    let mut node = RecorderNode::new(config, &info()).unwrap();
+    assert!(node.recorder.is_none());
+    let addr = node.live.as_ref().unwrap().local_addr();
+    assert!(addr.ip().is_loopback() && addr.port() != 0);
+    // The port is open: a TCP client connects.
+    std::net::TcpStream::connect(addr).unwrap();
+    let (mut out, mut counters) = (Collect::default(), Counters::default());
+    let mut ctx = Ctx::new(&mut out, &mut counters, 0);
+    let header = CloudHeader::new(0, 0.9, 1.0);
+    let points = vec![Point::new(1.0, 2.0, 30.0, 0.5, 0.95); 5];
+    for topic in [Topic::RawCloud, Topic::Cloud] {
+        let cloud = Cloud {
+            topic,
+            header: &header,
+            points: &points,
+        };
+        node.on_cloud(cloud, &mut ctx);
+    }
+    node.on_message(&Message::Pose(PoseEstimate::new()), &mut ctx);
+    let stats = node.live.as_ref().unwrap().stats();
+    // The raw cloud is not sent by default; 5 points at a budget of 2: 2.
+    assert_eq!((stats.clouds, stats.points, stats.messages), (1, 2, 1));
+    node.stop(&mut ctx);
+    assert_eq!((counters.frames_in, counters.frames_out), (3, 2));
+    assert!(std::net::TcpStream::connect(addr).is_err(), "stopped");
 }
