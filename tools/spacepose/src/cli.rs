@@ -87,6 +87,10 @@ pub struct UpArgs {
     /// model, the descriptor); docs/recording.md.
     #[arg(long, value_name = "RUN.mcap")]
     pub record: Option<PathBuf>,
+    /// Serve the run live to Foxglove: a Foxglove WebSocket server on this
+    /// loopback address (default 127.0.0.1:8765); docs/recording.md.
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8765")]
+    pub view: Option<std::net::SocketAddr>,
     /// Overrides.
     #[command(flatten)]
     pub overrides: ZenohOverrideArgs,
@@ -161,6 +165,10 @@ pub struct DemoArgs {
     /// included); docs/recording.md.
     #[arg(long, value_name = "RUN.mcap")]
     pub record: Option<PathBuf>,
+    /// Serve the run live to Foxglove: a Foxglove WebSocket server on this
+    /// loopback address (default 127.0.0.1:8765); docs/recording.md.
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8765")]
+    pub view: Option<std::net::SocketAddr>,
     /// Overrides (default prefix: a fresh random one).
     #[command(flatten)]
     pub overrides: ZenohOverrideArgs,

@@ -14,6 +14,7 @@ fn overrides(a: &ZenohOverrideArgs) -> Overrides {
         connect: (!a.connect.is_empty()).then(|| a.connect.clone()),
         host: None,
         record: None,
+        view: None,
     }
 }
 
@@ -22,12 +23,24 @@ fn record(arg: Option<&std::path::Path>) -> Result<Option<std::path::PathBuf>> {
     arg.map(super::record::record_path).transpose()
 }
 
+/// The live view of `--view`, checked ([`super::record::view_addr`]).
+fn view(arg: Option<std::net::SocketAddr>) -> Result<Option<std::net::SocketAddr>> {
+    arg.map(super::record::view_addr).transpose()
+}
+
 fn up_overrides(a: &UpArgs) -> Result<Overrides> {
     Ok(Overrides {
         host: a.host.clone(),
         record: record(a.record.as_deref())?,
+        view: view(a.view)?,
         ..overrides(&a.overrides)
     })
+}
+
+fn announce_view(addr: Option<std::net::SocketAddr>) {
+    if let Some(addr) = addr {
+        println!("live view: open ws://{addr} in Foxglove (Open connection > Foxglove WebSocket)");
+    }
 }
 
 fn seconds(name: &str, s: f64) -> Result<Duration> {
@@ -39,7 +52,9 @@ fn seconds(name: &str, s: f64) -> Result<Duration> {
 
 /// `spacepose up`.
 pub fn up(a: &UpArgs) -> Result<()> {
-    super::up::run(&a.deploy, &up_overrides(a)?, &mut std::io::stdout())
+    let overrides = up_overrides(a)?;
+    announce_view(overrides.view);
+    super::up::run(&a.deploy, &overrides, &mut std::io::stdout())
 }
 
 /// `spacepose supervise` (started by `up`).
@@ -90,6 +105,7 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
         json: a.json.clone(),
         overrides: Overrides {
             record: record(a.record.as_deref())?,
+            view: view(a.view)?,
             ..overrides(&a.overrides)
         },
         linger: seconds("--linger-s", a.linger_s)?,
@@ -104,6 +120,7 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
             .map(super::demo::chaos::SwapSpec::parse)
             .transpose()?,
     };
+    announce_view(opts.overrides.view);
     super::demo::run(&opts, &mut std::io::stdout())?;
     Ok(())
 }

@@ -1,10 +1,69 @@
-//! `--record RUN.mcap` of `spacepose demo` and `spacepose up`: a recorder
-//! instance added to the deployment, writing the run with Foxglove schemas.
+//! `--record RUN.mcap` and `--view [ADDR]` of `spacepose demo` and
+//! `spacepose up`: a recorder instance added to the deployment, writing the
+//! run with Foxglove schemas and/or streaming it live to Foxglove.
 
 use super::descriptor::{Descriptor, ServiceEntry};
 use anyhow::{Context, Result, bail};
 use spacepose_messages::ServiceKind;
+use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
+
+/// The live view's address of `--view` without a value.
+pub const DEFAULT_VIEW: &str = "127.0.0.1:8765";
+
+/// The address of `--view`, checked against the access rule: loopback only
+/// (the Foxglove WebSocket protocol has no authentication). Serving beyond
+/// this host takes `allow_non_loopback = true` in a recorder's `[live]`
+/// table of the descriptor (docs/security.md).
+///
+/// # Errors
+/// A non-loopback address.
+pub fn view_addr(addr: SocketAddr) -> Result<SocketAddr> {
+    if !addr.ip().is_loopback() {
+        bail!(
+            "--view {addr}: not a loopback address; the Foxglove WebSocket protocol has no \
+             authentication. To serve the run beyond this host, give a recorder service \
+             `[live] listen = \"{addr}\"` and `allow_non_loopback = true` in the descriptor"
+        );
+    }
+    Ok(addr)
+}
+
+/// Adds the live view on `addr` to `d`: to the first recorder without one
+/// (the one `--record` added, when both are given), else as a new recorder
+/// instance that writes no file. Nothing changes when a recorder already
+/// serves `addr` (the supervisor applies the overrides again).
+pub fn add_live_view(d: &mut Descriptor, addr: SocketAddr) {
+    let listen = addr.to_string();
+    let live_of = |s: &ServiceEntry| {
+        s.config
+            .get("live")
+            .and_then(toml::Value::as_table)
+            .cloned()
+    };
+    let serves = |s: &ServiceEntry| {
+        live_of(s).is_some_and(|l| l.get("listen").and_then(toml::Value::as_str) == Some(&listen))
+    };
+    if d.instances_of(ServiceKind::Recorder).any(serves) {
+        return;
+    }
+    let mut live = toml::Table::new();
+    live.insert("listen".into(), toml::Value::String(listen));
+    let live = toml::Value::Table(live);
+    if let Some(s) = d
+        .instances_of_mut(ServiceKind::Recorder)
+        .find(|s| !s.config.contains_key("live"))
+    {
+        s.config.insert("live".into(), live);
+        return;
+    }
+    let mut config = toml::Table::new();
+    let (target, scale) = target_of(d);
+    config.insert("target".into(), toml::Value::String(target));
+    config.insert("target_scale".into(), toml::Value::Float(scale));
+    config.insert("live".into(), live);
+    push_recorder(d, config);
+}
 
 /// The recording's path as the recorder will be given it: absolute (the
 /// services do not share the CLI's working directory), ending in `.mcap`,
@@ -54,6 +113,12 @@ pub fn add_recorder(d: &mut Descriptor, file: &Path) {
         }
         Err(e) => tracing::warn!("the descriptor is not recorded: {e}"),
     }
+    push_recorder(d, config);
+}
+
+/// Adds a recorder instance with `config`, named `recorder` (or
+/// `recorder-2`, ... when taken).
+fn push_recorder(d: &mut Descriptor, config: toml::Table) {
     let taken = |n: &str| d.services.iter().any(|s| s.name == n);
     let name = (1u32..)
         .map(|k| match k {
@@ -123,6 +188,36 @@ config = { target = "/m/x.stl", target_scale = 0.001 }
         assert_eq!(c["descriptor"].as_str(), Some(before.as_str()));
         add_recorder(&mut d, Path::new("/tmp/other.mcap"));
         assert_eq!(d.services.last().unwrap().name, "recorder-2");
+    }
+
+    #[test]
+    fn the_live_view_extends_the_recording_or_comes_alone() {
+        let addr: SocketAddr = DEFAULT_VIEW.parse().unwrap();
+        let mut d = Descriptor::parse(DEMO).unwrap();
+        add_recorder(&mut d, Path::new("/tmp/run.mcap"));
+        add_live_view(&mut d, addr);
+        add_live_view(&mut d, addr);
+        let recorders: Vec<&ServiceEntry> = d.instances_of(ServiceKind::Recorder).collect();
+        assert_eq!(
+            recorders.len(),
+            1,
+            "the recording's recorder serves the view"
+        );
+        let live = recorders[0].config["live"].as_table().unwrap();
+        assert_eq!(live["listen"].as_str(), Some("127.0.0.1:8765"));
+
+        let mut d = Descriptor::parse(DEMO).unwrap();
+        add_live_view(&mut d, "[::1]:9000".parse().unwrap());
+        let r = d.instances_of(ServiceKind::Recorder).next().unwrap();
+        assert!(!r.config.contains_key("file"), "a live view only");
+        assert_eq!(r.config["target"].as_str(), Some("/m/x.stl"));
+        assert_eq!(r.config["live"]["listen"].as_str(), Some("[::1]:9000"));
+        add_live_view(&mut d, addr);
+        assert_eq!(d.services.last().unwrap().name, "recorder-2");
+
+        assert!(view_addr(addr).is_ok());
+        let e = view_addr("0.0.0.0:8765".parse().unwrap()).unwrap_err();
+        assert!(format!("{e}").contains("allow_non_loopback"), "{e}");
     }
 
     #[test]

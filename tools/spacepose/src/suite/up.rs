@@ -27,6 +27,9 @@ pub struct Overrides {
     /// Record the run into this MCAP file (absolute): a recorder instance
     /// is added ([`super::record::add_recorder`]).
     pub record: Option<std::path::PathBuf>,
+    /// Serve the run live to Foxglove on this (loopback) address: a
+    /// recorder's live view ([`super::record::add_live_view`]).
+    pub view: Option<std::net::SocketAddr>,
 }
 
 impl Overrides {
@@ -43,6 +46,9 @@ impl Overrides {
         }
         if let Some(file) = &self.record {
             super::record::add_recorder(d, file);
+        }
+        if let Some(addr) = self.view {
+            super::record::add_live_view(d, addr);
         }
     }
 }
@@ -127,6 +133,9 @@ fn override_args(overrides: &Overrides) -> Vec<String> {
     }
     if let Some(r) = &overrides.record {
         args.extend(["--record".to_string(), r.display().to_string()]);
+    }
+    if let Some(v) = &overrides.view {
+        args.extend(["--view".to_string(), v.to_string()]);
     }
     args
 }
