@@ -84,6 +84,8 @@ pub struct LiveView {
     trajectory: VecDeque<SensorPose>,
     trajectory_ch: Channel<PosesInFrame>,
     scene_wanted: Arc<AtomicBool>,
+    /// Sensor time last published to the clients (ns).
+    time_sent_ns: u64,
     stats: LiveStats,
     /// Keeps the channels' context alive for the server's lifetime.
     _context: Arc<Context>,
@@ -121,9 +123,10 @@ impl LiveView {
             options,
             server: Some(server),
             addr,
-            trajectory: VecDeque::with_capacity(options.trajectory),
+            trajectory: VecDeque::new(),
             trajectory_ch,
             scene_wanted,
+            time_sent_ns: 0,
             stats: LiveStats::default(),
             _context: context,
         })
@@ -152,16 +155,23 @@ impl LiveView {
         self.log.set_target(mesh);
     }
 
-    /// Sends the scene when a client asked for it, and the sensor time.
+    /// Sends the scene again when a client asked for it.
     fn before_log(&mut self) {
         if self.scene_wanted.swap(false, Ordering::Relaxed) {
             self.log.resend_scene();
         }
     }
 
-    fn after_log(&self) {
-        if let Some(server) = &self.server {
-            server.broadcast_time(self.log.newest_ns());
+    /// Publishes the sensor time when it advanced (the protocol's `time`
+    /// goes through each client's control queue: once per frame, not per
+    /// message).
+    fn after_log(&mut self) {
+        let now = self.log.newest_ns();
+        if now > self.time_sent_ns
+            && let Some(server) = &self.server
+        {
+            server.broadcast_time(now);
+            self.time_sent_ns = now;
         }
     }
 

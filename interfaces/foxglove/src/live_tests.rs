@@ -3,7 +3,7 @@
 //! subscribe, binary message data.
 
 use super::*;
-use crate::POINT_STRIDE;
+use crate::cloud::POINT_STRIDE;
 use foxglove::Decode;
 use foxglove::messages::{PointCloud, PoseInFrame, SceneUpdate};
 use serde_json::{Value, json};
@@ -124,6 +124,7 @@ fn a_client_subscribes_and_receives_decimated_clouds_poses_and_the_model() {
         .map(|i| Point::new(i as f32, 0.0, 30.0, 0.5, 1.0))
         .collect();
     let mut got: BTreeMap<u32, Vec<u8>> = BTreeMap::new();
+    let mut sensor_ns = 0;
     let deadline = Instant::now() + Duration::from_secs(10);
     for k in 0u64.. {
         if got.len() == TOPICS.len() {
@@ -143,10 +144,12 @@ fn a_client_subscribes_and_receives_decimated_clouds_poses_and_the_model() {
         pose.instance = Name::new("tracker").unwrap();
         view.message(&Message::Pose(pose)).unwrap();
         while let Some(frame) = next(&mut socket) {
-            if let Ws::Binary(bytes) = frame
-                && let Some((id, _, payload)) = message_data(&bytes)
-            {
+            let Ws::Binary(bytes) = frame else { continue };
+            if let Some((id, _, payload)) = message_data(&bytes) {
                 got.insert(id, payload.to_vec());
+            } else if bytes.len() == 9 && bytes[0] == 0x02 {
+                // The protocol's `time`: the sensor clock.
+                sensor_ns = u64::from_le_bytes(bytes[1..].try_into().unwrap());
             }
         }
     }
@@ -160,6 +163,7 @@ fn a_client_subscribes_and_receives_decimated_clouds_poses_and_the_model() {
     assert_eq!(scene.entities.len(), 2);
     let track = PosesInFrame::decode(got[&4].as_slice()).unwrap();
     assert!(track.poses.len() >= 2, "{}", track.poses.len());
+    assert!(sensor_ns >= 1_000_000_000, "time {sensor_ns}");
     assert_eq!(view.clients(), 1);
     let stats = view.stop();
     assert_eq!(stats.points, 9 * stats.clouds);
