@@ -12,22 +12,26 @@ use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use mcap::{McapError, McapResult, Message, parse_record};
 use std::borrow::Cow;
 
-/// The messages of one in-memory MCAP file, in file order.
-pub(crate) struct BoundedMessages<'a> {
-    buf: &'a [u8],
+/// The messages of one in-memory MCAP file, in file order. The reader
+/// keeps its position, not the buffer: [`BoundedMessages::next_in`] is
+/// given the same file each time, so a cursor can outlive a borrow.
+pub(crate) struct BoundedMessages {
+    /// Bytes of the file handed to the reader so far.
+    pos: usize,
     reader: LinearReader,
     channels: ChannelAccumulator<'static>,
     done: bool,
 }
 
-impl<'a> BoundedMessages<'a> {
-    /// A reader of `buf`, which need not end with the MCAP magic.
-    pub fn new(buf: &'a [u8]) -> Self {
+impl BoundedMessages {
+    /// A reader of a file of `len` bytes, which need not end with the MCAP
+    /// magic.
+    pub fn new(len: usize) -> Self {
         let options = LinearReaderOptions::default()
             .with_skip_end_magic(true)
-            .with_record_length_limit(buf.len());
+            .with_record_length_limit(len);
         BoundedMessages {
-            buf,
+            pos: 0,
             reader: LinearReader::new_with_options(options),
             channels: ChannelAccumulator::default(),
             done: false,
@@ -62,19 +66,18 @@ impl<'a> BoundedMessages<'a> {
         }
         Ok(None)
     }
-}
 
-impl Iterator for BoundedMessages<'_> {
-    type Item = McapResult<Message<'static>>;
-
-    fn next(&mut self) -> Option<Self::Item> {
+    /// The next message of `buf` (the file given to every call), `None` at
+    /// its end or after an error.
+    pub fn next_in(&mut self, buf: &[u8]) -> Option<McapResult<Message<'static>>> {
         while !self.done {
             let owned = match self.reader.next_event()? {
                 Ok(LinearReadEvent::ReadRequest(need)) => {
-                    let n = need.min(self.buf.len());
-                    self.reader.insert(n).copy_from_slice(&self.buf[..n]);
+                    let rest = buf.get(self.pos..).unwrap_or_default();
+                    let n = need.min(rest.len());
+                    self.reader.insert(n).copy_from_slice(&rest[..n]);
                     self.reader.notify_read(n);
-                    self.buf = &self.buf[n..];
+                    self.pos += n;
                     continue;
                 }
                 Ok(LinearReadEvent::Record { data, opcode }) => {

@@ -71,9 +71,9 @@ fn scan_channels(path: &Path, buf: &[u8]) -> Result<Vec<ChannelInfo>, InputError
         path: path.to_owned(),
         message: e.to_string(),
     };
-    let stream = BoundedMessages::new(buf);
+    let mut stream = BoundedMessages::new(buf.len());
     let mut seen: BTreeMap<u16, ChannelInfo> = BTreeMap::new();
-    for message in stream {
+    while let Some(message) = stream.next_in(buf) {
         let message = match message {
             Ok(m) => m,
             Err(e) if seen.is_empty() => return Err(error(e)),

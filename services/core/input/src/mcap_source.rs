@@ -102,12 +102,15 @@ impl McapSource {
     pub fn frames(&self) -> McapFrames<'_> {
         McapFrames {
             source: self,
-            file: 0,
-            stream: None,
-            pending: None,
-            headers: BTreeMap::new(),
-            rank: 0,
+            cursor: McapCursor::default(),
         }
+    }
+
+    /// The next frame after `cursor` (which then moves past it): the owned
+    /// form of [`McapSource::frames`], for a reader that keeps its place
+    /// between calls.
+    pub fn next_frame(&self, cursor: &mut McapCursor) -> Option<Result<InputFrame, InputError>> {
+        cursor.next(self)
     }
 }
 
@@ -119,43 +122,66 @@ struct Pending {
     rank: u64,
 }
 
-/// Iterator over the frames of a [`McapSource`].
-pub struct McapFrames<'a> {
-    source: &'a McapSource,
+/// A place in a [`McapSource`]'s frames: the file, the reader's position in
+/// it, and a cloud waiting for its header. Holds no borrow of the source.
+#[derive(Default)]
+pub struct McapCursor {
     file: usize,
-    stream: Option<BoundedMessages<'a>>,
+    stream: Option<BoundedMessages>,
     pending: Option<Pending>,
     headers: BTreeMap<u64, Result<SpaceposeHeader, CloudError>>,
     rank: u64,
+}
+
+impl std::fmt::Debug for McapCursor {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("McapCursor")
+            .field("file", &self.file)
+            .field("rank", &self.rank)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Iterator over the frames of a [`McapSource`].
+pub struct McapFrames<'a> {
+    source: &'a McapSource,
+    cursor: McapCursor,
 }
 
 impl Iterator for McapFrames<'_> {
     type Item = Result<InputFrame, InputError>;
 
     fn next(&mut self) -> Option<Self::Item> {
+        self.cursor.next(self.source)
+    }
+}
+
+impl McapCursor {
+    /// The next frame of `source`.
+    fn next(&mut self, source: &McapSource) -> Option<Result<InputFrame, InputError>> {
         loop {
-            let Some(message) = self.next_message() else {
-                return self.pending.take().map(|p| self.emit(p));
+            let Some(message) = self.next_message(source) else {
+                return self.pending.take().map(|p| self.emit(source, p));
             };
             let message = match message {
                 Ok(m) => m,
                 Err(e) => return Some(Err(e)),
             };
             let topic = message.channel.topic.as_str();
-            if topic == self.source.topic {
+            if topic == source.topic {
                 let cloud = Pending {
                     log_time_ns: message.log_time,
                     data: message.data.into_owned(),
                     rank: self.rank,
                 };
                 self.rank += 1;
-                if self.source.header_topic.is_none() {
-                    return Some(self.emit(cloud));
+                if source.header_topic.is_none() {
+                    return Some(self.emit(source, cloud));
                 }
                 if let Some(previous) = self.pending.replace(cloud) {
-                    return Some(self.emit(previous));
+                    return Some(self.emit(source, previous));
                 }
-            } else if Some(topic) == self.source.header_topic.as_deref() {
+            } else if Some(topic) == source.header_topic.as_deref() {
                 self.headers
                     .insert(message.log_time, parse_header(&message.data));
                 if self
@@ -163,40 +189,42 @@ impl Iterator for McapFrames<'_> {
                     .as_ref()
                     .is_some_and(|p| p.log_time_ns == message.log_time)
                 {
-                    return self.pending.take().map(|p| self.emit(p));
+                    return self.pending.take().map(|p| self.emit(source, p));
                 }
             }
         }
     }
-}
 
-impl McapFrames<'_> {
     /// The next message of any channel, across files; a broken file yields
     /// its error once and the reading goes on with the next file.
-    fn next_message(&mut self) -> Option<Result<Message<'static>, InputError>> {
+    fn next_message(
+        &mut self,
+        source: &McapSource,
+    ) -> Option<Result<Message<'static>, InputError>> {
         loop {
-            if self.stream.is_none() {
-                let (_, buf) = self.source.files.get(self.file)?;
-                self.file += 1;
-                self.stream = Some(BoundedMessages::new(buf));
-            }
-            match self.stream.as_mut()?.next() {
+            let (path, buf) = source.files.get(self.file)?;
+            let stream = self
+                .stream
+                .get_or_insert_with(|| BoundedMessages::new(buf.len()));
+            match stream.next_in(buf) {
                 Some(Ok(m)) => return Some(Ok(m)),
                 Some(Err(e)) => {
                     self.stream = None;
-                    let path = &self.source.files[self.file - 1].0;
+                    self.file += 1;
                     return Some(Err(mcap_error(path, e)));
                 }
-                None => self.stream = None,
+                None => {
+                    self.stream = None;
+                    self.file += 1;
+                }
             }
         }
     }
 
     /// Decodes a cloud (with its header, if one came) into a frame.
-    fn emit(&mut self, cloud: Pending) -> Result<InputFrame, InputError> {
+    fn emit(&mut self, source: &McapSource, cloud: Pending) -> Result<InputFrame, InputError> {
         let header = self.headers.remove(&cloud.log_time_ns);
         self.headers = self.headers.split_off(&cloud.log_time_ns);
-        let source = self.source;
         let fail = |source_error| InputError::Message {
             topic: source.topic.clone(),
             log_time_ns: cloud.log_time_ns,

@@ -122,6 +122,14 @@ fn spacepose_clouds_pair_with_their_headers_in_either_order() {
         ]
     );
     assert_eq!(frames[1].points[1].t, 6.1 + 0.1);
+    // A cursor reads the same frames, and a new one starts again.
+    for _ in 0..2 {
+        let mut cursor = rec.cursor();
+        let again: Vec<_> = std::iter::from_fn(|| rec.next_frame(&mut cursor))
+            .map(|f| f.unwrap().index)
+            .collect();
+        assert_eq!(again, [41, 42, 2]);
+    }
 }
 
 #[test]
@@ -220,6 +228,12 @@ fn a_bag_reads_its_split_files_in_order() {
     let mut rec = open(&bag, &InputOptions::default()).unwrap();
     let xs: Vec<f32> = rec.frames().map(|f| f.unwrap().points[0].x).collect();
     assert_eq!(xs, [1.0, 2.0, 10.0]);
+    let mut cursor = rec.cursor();
+    let by_cursor: Vec<f32> = std::iter::from_fn(|| rec.next_frame(&mut cursor))
+        .map(|f| f.unwrap().points[0].x)
+        .collect();
+    assert_eq!(by_cursor, xs);
+    assert!(rec.next_frame(&mut cursor).is_none());
     let empty = tmp.path().join("sqlite");
     std::fs::create_dir(&empty).unwrap();
     std::fs::write(empty.join("metadata.yaml"), "x").unwrap();

@@ -39,6 +39,12 @@ fn frames_come_in_index_order_with_point_times_without_truth() {
         assert_eq!(f.scan_start_s, f.points[0].t);
         assert_eq!(f.scan_end_s, f.points.last().unwrap().t);
     }
+    let rec = crate::Recording::PcdDir(dir);
+    let mut cursor = rec.cursor();
+    let by_cursor: Vec<u64> = std::iter::from_fn(|| rec.next_frame(&mut cursor))
+        .map(|f| f.unwrap().index)
+        .collect();
+    assert_eq!(by_cursor, idx);
 }
 
 #[test]

@@ -2,7 +2,7 @@
 
 use crate::error::InputError;
 use crate::frame::InputFrame;
-use crate::mcap_source::{McapSource, bag_files};
+use crate::mcap_source::{McapCursor, McapSource, bag_files};
 use crate::options::InputOptions;
 use crate::pcd_dir::PcdDir;
 use std::path::Path;
@@ -17,6 +17,20 @@ pub enum Recording {
     PcdDir(PcdDir),
     /// An MCAP file or a ROS 2 bag.
     Mcap(McapSource),
+}
+
+/// A place in a [`Recording`]'s frames, kept by a reader between calls of
+/// [`Recording::next_frame`] (a replay that publishes one frame per slot).
+/// It holds no borrow: a new cursor starts the recording again.
+#[derive(Debug)]
+pub enum FrameCursor {
+    /// The next file of a frame directory.
+    PcdDir {
+        /// Its index in the directory's frame order.
+        next: usize,
+    },
+    /// A place in an MCAP file or bag.
+    Mcap(McapCursor),
 }
 
 /// Opens `path`, whatever it is: a directory with `metadata.yaml` is a ROS 2
@@ -95,6 +109,40 @@ impl Recording {
         match self {
             Self::PcdDir(d) => Box::new(d.iter()),
             Self::Mcap(m) => Box::new(m.frames()),
+        }
+    }
+
+    /// A cursor at the first frame.
+    pub fn cursor(&self) -> FrameCursor {
+        match self {
+            Self::PcdDir(_) => FrameCursor::PcdDir { next: 0 },
+            Self::Mcap(_) => FrameCursor::Mcap(McapCursor::default()),
+        }
+    }
+
+    /// The frame at `cursor`, which then moves past it; `None` at the end.
+    /// As with [`Recording::frames`], an error concerns one frame and the
+    /// next call goes on. A cursor of another kind of recording reads as
+    /// the end.
+    pub fn next_frame(&self, cursor: &mut FrameCursor) -> Option<Result<InputFrame, InputError>> {
+        match (self, cursor) {
+            (Self::PcdDir(d), FrameCursor::PcdDir { next }) => {
+                let frame = d.read(*next)?;
+                *next += 1;
+                Some(frame)
+            }
+            (Self::Mcap(m), FrameCursor::Mcap(c)) => m.next_frame(c),
+            _ => None,
+        }
+    }
+
+    /// The recorded frame period (s) when the recording states one (the
+    /// median of a frame directory's `truth.csv`); otherwise a replay paces
+    /// frames by their scan start times.
+    pub fn recorded_period_s(&self) -> Option<f64> {
+        match self {
+            Self::PcdDir(d) => d.recorded_period_s(),
+            Self::Mcap(_) => None,
         }
     }
 
