@@ -70,6 +70,10 @@ pub struct Counters {
     pub errors: u64,
     /// Sequence of the last frame processed.
     pub last_frame: u64,
+    /// Frames whose per-point times were derived over the scan interval
+    /// because the recording has no time field (a replay source; the
+    /// tracker's motion compensation then rests on an assumption).
+    pub derived_times: u64,
 }
 
 impl Counters {

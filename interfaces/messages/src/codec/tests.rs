@@ -107,6 +107,7 @@ pub(super) fn health(rng: &mut impl Rng) -> Health {
             rejected_wire: rng.random(),
             errors: rng.random(),
             last_frame: rng.random(),
+            derived_times: rng.random(),
         },
         published_ns: rng.random(),
         ..Health::new(

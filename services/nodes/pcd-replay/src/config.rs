@@ -10,9 +10,16 @@ use std::time::Duration;
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PcdReplayConfig {
-    /// Directory of `frame_NNNNNN.pcd` / `.ply` (and `truth.csv`).
-    pub dir: PathBuf,
-    /// Frames per second; 0 = the recorded period (truth.csv), else 1 Hz.
+    /// The recording: a directory of `frame_NNNNNN.pcd` / `.ply` (and
+    /// `truth.csv`), an MCAP file or a ROS 2 bag (`spacepose_input::open`).
+    /// The key `dir` is accepted for it too.
+    #[serde(alias = "dir")]
+    pub input: PathBuf,
+    /// Point-cloud topic of an MCAP file or bag; unset: the only cloud
+    /// channel, or the raw clouds of a spacepose recording.
+    pub topic: Option<String>,
+    /// Frames per second; 0 = at recorded speed (the recorded period of
+    /// `truth.csv`, else the steps between scan starts), else 1 Hz.
     pub rate_hz: f64,
     /// Start again after the last frame.
     #[serde(rename = "loop")]
@@ -31,7 +38,8 @@ pub struct PcdReplayConfig {
 impl Default for PcdReplayConfig {
     fn default() -> Self {
         PcdReplayConfig {
-            dir: PathBuf::from("frames"),
+            input: PathBuf::from("frames"),
+            topic: None,
             rate_hz: 0.0,
             looping: false,
             exit_at_end: false,
@@ -50,25 +58,25 @@ impl ServiceConfig for PcdReplayConfig {
                 self.rate_hz
             ));
         }
-        if self.dir.as_os_str().is_empty() {
-            return Err("dir must not be empty".into());
+        if self.input.as_os_str().is_empty() {
+            return Err("input must not be empty".into());
         }
         self.input_options().validate()
     }
 }
 
 impl PcdReplayConfig {
-    /// How the directory is read: the time mapping and scan period.
+    /// How the recording is read: the topic, time mapping and scan period.
     pub fn input_options(&self) -> InputOptions {
         InputOptions {
-            topic: None,
+            topic: self.topic.clone(),
             time: self.time.clone(),
             scan_period_s: self.scan_period_s,
         }
     }
 
     /// The frame period: `1 / rate_hz`, else the recording's (`recorded_s`,
-    /// from `truth.csv`), else 1 s.
+    /// from `truth.csv`), else 1 s (the step when scan starts give none).
     pub fn period(&self, recorded_s: Option<f64>) -> Duration {
         let one_second = Duration::from_secs(1);
         if self.rate_hz > 0.0 {
@@ -102,14 +110,17 @@ mod tests {
         let c: PcdReplayConfig =
             toml::from_str("dir = \"rec\"\nrate_hz = 4.0\nloop = true\nsensor_id = 3\n").unwrap();
         assert_eq!(
-            (c.dir.to_str(), c.looping, c.sensor_id),
+            (c.input.to_str(), c.looping, c.sensor_id),
             (Some("rec"), true, 3)
         );
         assert!(toml::from_str::<PcdReplayConfig>("looping = true").is_err());
         let c: PcdReplayConfig = toml::from_str("rate_hz = nan").unwrap();
         assert!(c.validate().unwrap_err().contains("rate_hz"));
-        let c: PcdReplayConfig = toml::from_str("dir = \"\"").unwrap();
-        assert!(c.validate().unwrap_err().contains("dir"));
+        let c: PcdReplayConfig = toml::from_str("input = \"\"").unwrap();
+        assert!(c.validate().unwrap_err().contains("input"));
+        let c: PcdReplayConfig =
+            toml::from_str("input = \"run.mcap\"\ntopic = \"/points\"").unwrap();
+        assert_eq!(c.input_options().topic.as_deref(), Some("/points"));
         let c: PcdReplayConfig = toml::from_str("scan_period_s = nan").unwrap();
         assert!(c.validate().unwrap_err().contains("scan_period_s"));
         let c: PcdReplayConfig =

@@ -1,9 +1,9 @@
 //! The replay node: one recorded frame per slot of the frame clock, in
-//! index order, optionally in a loop that continues the sensor clock.
+//! recorded order, optionally in a loop that continues the sensor clock.
 
 use crate::config::PcdReplayConfig;
 use crate::wire::cloud_header;
-use spacepose_input::{InputFrame, PcdDir};
+use spacepose_input::{FrameCursor, InputFrame, Recording};
 use spacepose_messages::{MAX_POINTS, ServiceKind, Topic};
 use spacepose_runtime::{Ctx, Flow, Node, NodeInfo};
 use std::time::Duration;
@@ -23,11 +23,13 @@ pub enum Phase {
     Idle,
 }
 
-/// The current pass over the directory.
+/// Longest step between two recorded scan starts replayed as it was
+/// recorded (s); a longer gap (a pause in the recording) takes one period.
+pub const MAX_RECORDED_STEP_S: f64 = 10.0;
+
+/// The current pass over the recording.
 #[derive(Debug, Default)]
 struct Pass {
-    /// Next file to read.
-    file: usize,
     /// Scan start of the pass's first readable frame, as recorded.
     first_start: Option<f64>,
     /// Scan end of the pass's last readable frame, as recorded.
@@ -36,12 +38,17 @@ struct Pass {
     shift_s: f64,
 }
 
-/// Publishes a directory of recorded frames as raw clouds.
+/// Publishes a recording's frames as raw clouds.
 pub struct PcdReplayNode {
-    dir: PcdDir,
+    recording: Recording,
+    /// The next frame of the recording (a new cursor starts a pass).
+    cursor: FrameCursor,
     config: PcdReplayConfig,
     period: Duration,
     period_ns: i64,
+    /// At recorded speed without a recorded period: each step is the one
+    /// between the recorded scan starts.
+    pace_by_scan: bool,
     pass: Pass,
     /// The next frame, read ahead of its slot.
     pending: Option<InputFrame>,
@@ -56,22 +63,26 @@ impl Node for PcdReplayNode {
     type Config = PcdReplayConfig;
 
     fn new(config: PcdReplayConfig, _: &NodeInfo) -> anyhow::Result<Self> {
-        let dir = PcdDir::open(&config.dir, &config.input_options())?;
-        for w in dir.warnings() {
+        let recording = spacepose_input::open(&config.input, &config.input_options())?;
+        for w in recording.warnings() {
             warn!("{w}");
         }
-        let period = config.period(dir.recorded_period_s());
+        let recorded_s = recording.recorded_period_s();
+        let period = config.period(recorded_s);
+        let pace_by_scan = config.rate_hz == 0.0 && recorded_s.is_none();
         info!(
-            frames = dir.len(),
             period_s = period.as_secs_f64(),
-            dir = %config.dir.display(),
-            "replay running"
+            pace_by_scan,
+            "replay running: {}",
+            recording.describe()
         );
         Ok(PcdReplayNode {
-            dir,
+            cursor: recording.cursor(),
+            recording,
             config,
             period,
             period_ns: i64::try_from(period.as_nanos()).unwrap_or(i64::MAX),
+            pace_by_scan,
             pass: Pass::default(),
             pending: None,
             sequence: 0,
@@ -89,15 +100,20 @@ impl Node for PcdReplayNode {
                 self.read_ahead(ctx)
             }
             Phase::Running { slot_ns } if ctx.now_ns >= slot_ns => {
-                if let Some(frame) = self.pending.take() {
+                let sent = self.pending.take().map(|frame| {
                     self.publish(&frame, ctx);
+                    frame.scan_start_s
+                });
+                let flow = self.read_ahead(ctx);
+                if matches!(self.phase, Phase::Running { .. }) {
+                    // Late slots are not caught up: the next one is a step later.
+                    let step_ns = self.step_ns(sent);
+                    let floor = ctx.now_ns.saturating_sub(step_ns);
+                    self.phase = Phase::Running {
+                        slot_ns: slot_ns.max(floor).saturating_add(step_ns),
+                    };
                 }
-                // Late slots are not caught up: the next one is a period later.
-                let floor = ctx.now_ns.saturating_sub(self.period_ns);
-                self.phase = Phase::Running {
-                    slot_ns: slot_ns.max(floor).saturating_add(self.period_ns),
-                };
-                self.read_ahead(ctx)
+                flow
             }
             Phase::Running { .. } | Phase::Idle => Flow::Continue,
         }
@@ -123,6 +139,19 @@ impl PcdReplayNode {
         self.period
     }
 
+    /// The step to the next slot: the recorded step between the scan starts
+    /// of the frame sent (`sent_start_s`) and the next one when pacing by
+    /// scan, within (0, [`MAX_RECORDED_STEP_S`]]; else the period.
+    fn step_ns(&self, sent_start_s: Option<f64>) -> i64 {
+        let recorded = self
+            .pending
+            .as_ref()
+            .zip(sent_start_s)
+            .map(|(next, sent)| next.scan_start_s - sent)
+            .filter(|s| self.pace_by_scan && *s > 0.0 && *s <= MAX_RECORDED_STEP_S);
+        recorded.map_or(self.period_ns, |s| (s * 1e9).round() as i64)
+    }
+
     /// Reads the next frame for its slot; at the end of the recording,
     /// exits or idles.
     fn read_ahead(&mut self, ctx: &mut Ctx<'_>) -> Flow {
@@ -141,20 +170,19 @@ impl PcdReplayNode {
         Flow::Continue
     }
 
-    /// The next readable frame on the sensor clock; corrupt files are
+    /// The next readable frame on the sensor clock; corrupt frames are
     /// logged, counted and skipped. `None` at the end of the recording:
     /// the last file without `loop`, or a whole pass without a readable
     /// frame.
     fn next_frame(&mut self, ctx: &mut Ctx<'_>) -> Option<InputFrame> {
         loop {
-            let Some(result) = self.dir.read(self.pass.file) else {
+            let Some(result) = self.recording.next_frame(&mut self.cursor) else {
                 self.next_pass()?;
                 continue;
             };
-            self.pass.file += 1;
             match result {
                 Ok(mut frame) => {
-                    self.note_derived_times(&frame);
+                    self.note_derived_times(&frame, ctx);
                     self.pass.first_start.get_or_insert(frame.scan_start_s);
                     self.pass.last_end = Some(frame.scan_end_s);
                     frame.shift_time(self.pass.shift_s);
@@ -182,13 +210,14 @@ impl PcdReplayNode {
             shift_s: self.pass.shift_s + ((b - a) + self.period.as_secs_f64()),
             ..Pass::default()
         };
+        self.cursor = self.recording.cursor();
         Some(())
     }
 
     /// Frames without a time field get times derived over their scan
-    /// interval: warned about on the first one, counted, and the count
-    /// logged at the end of the recording.
-    fn note_derived_times(&mut self, frame: &InputFrame) {
+    /// interval: warned about on the first one, counted (health
+    /// `derived_times`), and the count logged at the end of the recording.
+    fn note_derived_times(&mut self, frame: &InputFrame, ctx: &mut Ctx<'_>) {
         if !frame.times_derived() {
             return;
         }
@@ -201,6 +230,7 @@ impl PcdReplayNode {
             );
         }
         self.derived_times += 1;
+        ctx.counters.derived_times = self.derived_times;
     }
 
     /// Frames read so far whose point times were derived.

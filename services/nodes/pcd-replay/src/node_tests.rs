@@ -68,7 +68,7 @@ fn recording(dir: &Path, good: &[usize], corrupt: &[usize]) {
 
 fn node(dir: &Path, rate_hz: f64, looping: bool, exit_at_end: bool) -> PcdReplayNode {
     let config = PcdReplayConfig {
-        dir: dir.to_owned(),
+        input: dir.to_owned(),
         rate_hz,
         looping,
         exit_at_end,
@@ -189,7 +189,7 @@ fn frames_without_a_time_field_get_derived_times_and_are_counted() {
     let mut c = Counters::default();
     poll(&mut n, &mut c, T0);
     let (_, sent) = poll(&mut n, &mut c, T0);
-    assert_eq!(n.derived_times(), 1);
+    assert_eq!((n.derived_times(), c.derived_times), (1, 1));
     let (header, points) = &sent[0];
     // truth.csv row 1: [1.28, 2.0]; times spread over it, never 0.
     assert_eq!((header.scan_start_s, header.scan_end_s), (1.28, 2.0));
@@ -253,4 +253,61 @@ fn on_a_local_bus_the_replay_feeds_ingest() {
         Phase::Idle
     );
     assert_eq!(bus.counters(ingest).unwrap().frames_out, 3);
+}
+
+/// A spacepose MCAP recording replays at recorded speed: each slot is the
+/// step between the recorded scan starts, the scan times and points are the
+/// recorded ones, and a pause longer than [`MAX_RECORDED_STEP_S`] takes one
+/// period (1 s).
+#[test]
+fn an_mcap_recording_replays_at_the_recorded_steps() {
+    use spacepose_foxglove::{RecordOptions, Recorder};
+    use spacepose_messages::Cloud;
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("run.mcap");
+    let starts = [5.0, 5.1, 5.35, 25.0];
+    let mut rec = Recorder::create(&path, RecordOptions::default()).unwrap();
+    for (k, start) in starts.iter().enumerate() {
+        let pts: Vec<Point> = points(k, 50)
+            .into_iter()
+            .map(|mut p| {
+                p.t = p.t - (k as f64 + 0.3) + start;
+                p
+            })
+            .collect();
+        let header = CloudHeader::new(k as u64 + 7, *start, start + 0.09);
+        let cloud = Cloud {
+            topic: Topic::RawCloud,
+            header: &header,
+            points: &pts,
+        };
+        assert!(rec.cloud(cloud).unwrap());
+    }
+    rec.close().unwrap();
+    let mut n = node(&path, 0.0, false, true);
+    let mut c = Counters::default();
+    poll(&mut n, &mut c, T0);
+    let mut now = T0;
+    let mut got = Vec::new();
+    for step_ms in [100, 250, 1000] {
+        let (_, sent) = poll(&mut n, &mut c, now);
+        got.extend(sent);
+        assert_eq!(n.next_wake_ns(), Some(now + step_ms * MS));
+        now += step_ms * MS;
+    }
+    let (flow, sent) = poll(&mut n, &mut c, now);
+    got.extend(sent);
+    assert_eq!(flow, Flow::Finished);
+    let scans: Vec<(u64, f64, f64)> = got
+        .iter()
+        .map(|(h, _)| (h.sequence, h.scan_start_s, h.scan_end_s))
+        .collect();
+    let want: Vec<(u64, f64, f64)> = starts
+        .iter()
+        .enumerate()
+        .map(|(k, s)| (k as u64, *s, s + 0.09))
+        .collect();
+    assert_eq!(scans, want);
+    assert!((got[2].1[3].t - (5.35 + 3e-3)).abs() < 1e-9);
+    assert_eq!((c.frames_out, c.errors, c.derived_times), (4, 0, 0));
 }
