@@ -30,7 +30,7 @@ pub enum FrameCursor {
         next: usize,
     },
     /// A place in an MCAP file or bag.
-    Mcap(McapCursor),
+    Mcap(Box<McapCursor>),
 }
 
 /// Opens `path`, whatever it is: a directory with `metadata.yaml` is a ROS 2
@@ -116,7 +116,7 @@ impl Recording {
     pub fn cursor(&self) -> FrameCursor {
         match self {
             Self::PcdDir(_) => FrameCursor::PcdDir { next: 0 },
-            Self::Mcap(_) => FrameCursor::Mcap(McapCursor::default()),
+            Self::Mcap(_) => FrameCursor::Mcap(Box::default()),
         }
     }
 
