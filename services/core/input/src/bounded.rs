@@ -20,6 +20,8 @@ pub(crate) struct BoundedMessages {
     pos: usize,
     reader: LinearReader,
     channels: ChannelAccumulator<'static>,
+    /// Attachments met so far (name, data), for [`crate::read_messages`].
+    pub attachments: Vec<(String, Vec<u8>)>,
     done: bool,
 }
 
@@ -34,6 +36,7 @@ impl BoundedMessages {
             pos: 0,
             reader: LinearReader::new_with_options(options),
             channels: ChannelAccumulator::default(),
+            attachments: Vec::new(),
             done: false,
         }
     }
@@ -46,6 +49,9 @@ impl BoundedMessages {
                     .add_schema(header, Cow::Owned(data.into_owned()))?;
             }
             Record::Channel(c) => self.channels.add_channel(c)?,
+            Record::Attachment { header, data, .. } => {
+                self.attachments.push((header.name, data.into_owned()));
+            }
             Record::Message { header, data } => {
                 let channel =
                     self.channels
