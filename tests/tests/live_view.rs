@@ -199,7 +199,7 @@ fn check_poses(got: &Received) {
         .collect();
     assert!(tracks.windows(2).all(|w| w[1] >= w[0]), "{tracks:?}");
     assert!(
-        tracks.last().is_some_and(|&n| n >= 2 && n <= 100),
+        tracks.last().is_some_and(|n| (2..=100).contains(n)),
         "{tracks:?}"
     );
     let scene = SceneUpdate::decode(on(got, "/spacepose/scene")[0].1.as_slice()).unwrap();
