@@ -48,6 +48,9 @@ pub enum Command {
     /// The main job: a simulated tumbling rendezvous through the real service
     /// processes, scored against truth.
     Demo(DemoArgs),
+    /// Replay a recorded run (`--record RUN.mcap`) through the suite and
+    /// compare the poses with the recorded ones.
+    Replay(ReplayArgs),
     /// Ground tool: telemetry over zenoh as a live table, optionally recorded.
     Ground(GroundArgs),
     /// Target packages: prepare a mesh into one, or show one.
@@ -169,6 +172,32 @@ pub struct DemoArgs {
     /// loopback address (default 127.0.0.1:8765); docs/recording.md.
     #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8765")]
     pub view: Option<std::net::SocketAddr>,
+    /// Overrides (default prefix: a fresh random one).
+    #[command(flatten)]
+    pub overrides: ZenohOverrideArgs,
+}
+
+/// `spacepose replay`.
+#[derive(Debug, Args)]
+pub struct ReplayArgs {
+    /// The recording: an MCAP file written by `demo --record` or `up --record`.
+    #[arg(value_name = "RUN.mcap")]
+    pub input: PathBuf,
+    /// Run this descriptor instead of the one recorded in the file.
+    #[arg(long)]
+    pub deploy: Option<PathBuf>,
+    /// Frames per second (0 = recorded speed); default: the recorded run's rate.
+    #[arg(long)]
+    pub rate_hz: Option<f64>,
+    /// Write the comparison as JSON.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Seconds to wait for missing poses once the last frame is out.
+    #[arg(long, default_value_t = 5.0)]
+    pub linger_s: f64,
+    /// Record the replay into this MCAP file.
+    #[arg(long, value_name = "OUT.mcap")]
+    pub record: Option<PathBuf>,
     /// Overrides (default prefix: a fresh random one).
     #[command(flatten)]
     pub overrides: ZenohOverrideArgs,

@@ -27,6 +27,7 @@ fn main() -> ExitCode {
         Command::Status(args) => spacepose::suite::cmd::status(&args),
         Command::Down(args) => spacepose::suite::cmd::down(&args),
         Command::Demo(args) => spacepose::suite::cmd::demo(&args),
+        Command::Replay(args) => spacepose::suite::cmd::replay(&args),
         Command::Ground(args) => spacepose::suite::cmd::ground(&args),
     };
     match result {

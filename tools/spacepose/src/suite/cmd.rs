@@ -2,7 +2,9 @@
 
 use super::demo::DemoOptions;
 use super::up::Overrides;
-use crate::cli::{DemoArgs, GroundArgs, PrefixArgs, SwapArgs, UpArgs, ZenohOverrideArgs};
+use crate::cli::{
+    DemoArgs, GroundArgs, PrefixArgs, ReplayArgs, SwapArgs, UpArgs, ZenohOverrideArgs,
+};
 use crate::ground::GroundOptions;
 use anyhow::{Result, bail};
 use std::time::Duration;
@@ -122,6 +124,26 @@ pub fn demo(a: &DemoArgs) -> Result<()> {
     };
     announce_view(opts.overrides.view);
     super::demo::run(&opts, &mut std::io::stdout())?;
+    Ok(())
+}
+
+/// `spacepose replay`.
+pub fn replay(a: &ReplayArgs) -> Result<()> {
+    if let Some(r) = a.rate_hz.filter(|r| !(r.is_finite() && *r >= 0.0)) {
+        bail!("--rate-hz must be a finite number >= 0, got {r}");
+    }
+    let opts = super::replay::ReplayOptions {
+        input: a.input.clone(),
+        deploy: a.deploy.clone(),
+        rate_hz: a.rate_hz,
+        json: a.json.clone(),
+        overrides: Overrides {
+            record: record(a.record.as_deref())?,
+            ..overrides(&a.overrides)
+        },
+        linger: seconds("--linger-s", a.linger_s)?,
+    };
+    super::replay::run(&opts, &mut std::io::stdout())?;
     Ok(())
 }
 

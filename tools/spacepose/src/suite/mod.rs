@@ -15,6 +15,7 @@ pub mod plan;
 pub mod problems;
 pub mod process;
 pub mod record;
+pub mod replay;
 pub mod restart;
 pub mod state;
 pub mod status;

@@ -362,7 +362,7 @@ fn inject(
 }
 
 /// Fails when an instance is down for good (a finished sensor may exit).
-fn check_failed(sup: &Supervisor) -> Result<()> {
+pub(crate) fn check_failed(sup: &Supervisor) -> Result<()> {
     for i in &sup.suite.state.instances {
         if i.status == "failed" {
             bail!(

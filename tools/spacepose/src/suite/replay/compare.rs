@@ -1,0 +1,173 @@
+//! The replayed run against the recorded one: per frame and tracker, the
+//! same status, the same pose bit for bit, or how far apart and why.
+
+use super::recorded::RecordedRun;
+use serde::Serialize;
+use spacepose_foxglove::AcquisitionRecord;
+use spacepose_messages::telemetry::TelemetryPose;
+use std::collections::BTreeMap;
+
+/// An acquisition as compared: frame, method, accepted.
+pub type AcquisitionKey = (u64, String, bool);
+
+/// How the replay compares with the recording.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct Comparison {
+    /// Poses in the recording.
+    pub recorded_poses: usize,
+    /// Poses the replay published.
+    pub replayed_poses: usize,
+    /// Poses in both (same tracker instance, same frame).
+    pub matched: usize,
+    /// Of those, the same status.
+    pub same_status: usize,
+    /// Of those, the same status and bit-identical rotation and position.
+    pub identical: usize,
+    /// Largest rotation between a recorded and a replayed pose (deg).
+    pub max_angle_deg: f64,
+    /// Largest distance between a recorded and a replayed position (mm).
+    pub max_position_mm: f64,
+    /// Recorded frame of the first pose that differs (status or value).
+    pub first_difference: Option<u64>,
+    /// Recorded poses without a replayed one.
+    pub missing_in_replay: usize,
+    /// Replayed poses without a recorded one.
+    pub extra_in_replay: usize,
+    /// The recording's acquisitions.
+    pub recorded_acquisitions: Vec<AcquisitionKey>,
+    /// The replay's acquisitions (frames in the recording's numbering).
+    pub replayed_acquisitions: Vec<AcquisitionKey>,
+    /// Why the replay differs, when it does.
+    pub reasons: Vec<String>,
+}
+
+impl Comparison {
+    /// True when every recorded pose was replayed identically, with nothing extra.
+    pub fn reproduced(&self) -> bool {
+        self.recorded_poses > 0
+            && self.identical == self.recorded_poses
+            && self.extra_in_replay == 0
+    }
+}
+
+type Key = (String, u64);
+
+fn by_key(poses: &[TelemetryPose]) -> BTreeMap<Key, &TelemetryPose> {
+    poses
+        .iter()
+        .map(|p| ((p.instance.clone(), p.sequence), p))
+        .collect()
+}
+
+fn acquisition_keys(list: &[AcquisitionRecord]) -> Vec<AcquisitionKey> {
+    list.iter()
+        .map(|a| (a.sequence, a.method.clone(), a.accepted))
+        .collect()
+}
+
+/// The angle (deg) and distance (mm) between two poses.
+fn apart(a: &TelemetryPose, b: &TelemetryPose) -> (f64, f64) {
+    let [w0, x0, y0, z0] = a.q_sensor_target;
+    let [w1, x1, y1, z1] = b.q_sensor_target;
+    let dot = (w0 * w1 + x0 * x1 + y0 * y1 + z0 * z1).abs().min(1.0);
+    let d: f64 = (0..3)
+        .map(|i| (a.p_sensor_target_m[i] - b.p_sensor_target_m[i]).powi(2))
+        .sum();
+    ((2.0 * dot.acos()).to_degrees(), d.sqrt() * 1e3)
+}
+
+/// Compares the recorded run with the replayed poses and acquisitions,
+/// whose frame `k` is the recording's `k`-th raw cloud.
+pub fn compare(
+    recorded: &RecordedRun,
+    mut poses: Vec<TelemetryPose>,
+    mut acquisitions: Vec<AcquisitionRecord>,
+) -> Comparison {
+    let renumber = |k: u64| {
+        usize::try_from(k)
+            .ok()
+            .and_then(|i| recorded.raw_sequences.get(i).copied())
+            .unwrap_or(u64::MAX)
+    };
+    poses
+        .iter_mut()
+        .for_each(|p| p.sequence = renumber(p.sequence));
+    acquisitions
+        .iter_mut()
+        .for_each(|a| a.sequence = renumber(a.sequence));
+    let rec = by_key(&recorded.poses);
+    let rep = by_key(&poses);
+    let mut c = Comparison {
+        recorded_poses: rec.len(),
+        replayed_poses: rep.len(),
+        recorded_acquisitions: acquisition_keys(&recorded.acquisitions),
+        replayed_acquisitions: acquisition_keys(&acquisitions),
+        ..Comparison::default()
+    };
+    for (key, r) in &rec {
+        let Some(p) = rep.get(key) else {
+            c.missing_in_replay += 1;
+            continue;
+        };
+        c.matched += 1;
+        let same_status = r.status == p.status;
+        let same_pose =
+            r.q_sensor_target == p.q_sensor_target && r.p_sensor_target_m == p.p_sensor_target_m;
+        c.same_status += usize::from(same_status);
+        c.identical += usize::from(same_status && same_pose);
+        if !(same_status && same_pose) {
+            let first = c.first_difference.get_or_insert(key.1);
+            *first = (*first).min(key.1);
+        }
+        let (deg, mm) = apart(r, p);
+        c.max_angle_deg = c.max_angle_deg.max(deg);
+        c.max_position_mm = c.max_position_mm.max(mm);
+    }
+    c.extra_in_replay = rep.keys().filter(|k| !rec.contains_key(*k)).count();
+    c.reasons = reasons(recorded, &c);
+    c
+}
+
+/// Why the replay could not reproduce the recording, as far as it shows.
+fn reasons(recorded: &RecordedRun, c: &Comparison) -> Vec<String> {
+    let mut out = Vec::new();
+    if recorded.raw_gaps() > 0 {
+        out.push(format!(
+            "the recording skips raw clouds at {} places (decimated with raw_cloud_every, \
+             or frames lost while recording): the replayed suite saw other frames",
+            recorded.raw_gaps()
+        ));
+    }
+    if c.recorded_acquisitions != c.replayed_acquisitions {
+        out.push(format!(
+            "acquisitions (frame, method, accepted) differ: recorded {:?}, replayed {:?}. \
+             init runs beside the tracker, and the frame its result lands on depends on \
+             the machine's load, which a replay does not reproduce",
+            c.recorded_acquisitions, c.replayed_acquisitions
+        ));
+    }
+    if c.missing_in_replay > 0 || c.extra_in_replay > 0 {
+        out.push(format!(
+            "{} recorded poses were not replayed and {} replayed poses were not recorded: \
+             a tracker busy with a frame drops the next one, so which frames get a pose \
+             depends on timing",
+            c.missing_in_replay, c.extra_in_replay
+        ));
+    }
+    if out.is_empty() && c.identical < c.matched {
+        out.push(format!(
+            "with the same frames and acquisitions, poses differ from frame {} (by at \
+             most {:.1e} deg, {:.1e} mm): the filter state that seeds each frame reaches \
+             the tracker concurrently, so which state seeds a frame depends on timing; \
+             `spacepose track` on the recording runs them in lockstep and is bit-identical",
+            c.first_difference.unwrap_or_default(),
+            c.max_angle_deg,
+            c.max_position_mm
+        ));
+    }
+    out
+}
+
+#[cfg(test)]
+#[path = "compare_tests.rs"]
+mod tests;
