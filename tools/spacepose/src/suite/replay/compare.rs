@@ -149,17 +149,20 @@ fn reasons(recorded: &RecordedRun, c: &Comparison) -> Vec<String> {
     if c.missing_in_replay > 0 || c.extra_in_replay > 0 {
         out.push(format!(
             "{} recorded poses were not replayed and {} replayed poses were not recorded: \
-             a tracker busy with a frame drops the next one, so which frames get a pose \
-             depends on timing",
+             a cloud subscriber buffers 2 frames and overwrites the oldest \
+             (CLOUD_BUFFER in interfaces/bus), so a service that falls behind loses \
+             frames, and which ones depends on timing",
             c.missing_in_replay, c.extra_in_replay
         ));
     }
     if out.is_empty() && c.identical < c.matched {
         out.push(format!(
             "with the same frames and acquisitions, poses differ from frame {} (by at \
-             most {:.1e} deg, {:.1e} mm): the filter state that seeds each frame reaches \
-             the tracker concurrently, so which state seeds a frame depends on timing; \
-             `spacepose track` on the recording runs them in lockstep and is bit-identical",
+             most {:.1e} deg, {:.1e} mm): the filter service's state replaces the \
+             tracker's own prediction when it arrives before the next frame \
+             (apply_filter_state in services/nodes/tracker/src/track.rs), and whether it \
+             does depends on scheduling; `spacepose track` on the recording runs them in \
+             lockstep and is bit-identical",
             c.first_difference.unwrap_or_default(),
             c.max_angle_deg,
             c.max_position_mm
