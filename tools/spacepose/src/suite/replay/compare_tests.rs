@@ -67,7 +67,7 @@ fn differences_are_measured_and_explained() {
     // Same acquisitions and frames: the remaining cause is named.
     let c = compare(&rec, replay[..3].to_vec(), vec![acquisition(2)]);
     assert_eq!(c.reasons.len(), 1);
-    assert!(c.reasons[0].contains("filter state"), "{:?}", c.reasons);
+    assert!(c.reasons[0].contains("filter service's state"), "{:?}", c.reasons);
 }
 
 #[test]
