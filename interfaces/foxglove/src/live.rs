@@ -227,7 +227,9 @@ impl LiveView {
         Ok(())
     }
 
-    /// Stops the server: clients are disconnected.
+    /// Stops the server: clients are disconnected, the server's tasks
+    /// have ended. The SDK closes the listening socket asynchronously, a
+    /// moment later.
     pub fn stop(mut self) -> LiveStats {
         self.shutdown();
         self.stats
