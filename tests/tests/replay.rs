@@ -1,9 +1,8 @@
 //! `spacepose replay RUN.mcap`: a recorded demo fed back through the suite.
 //! Every recorded frame goes back in; when the replay's acquisitions land
 //! on the recorded frames and no frame is dropped, every pose has the
-//! recorded status and is the recorded pose to 1e-3° and 1e-3 mm (the
-//! rest is the timing of filter states); otherwise the comparison names
-//! the reason. Offline tracking of the same file is bit-identical run to
+//! recorded status and is the recorded pose bit for bit; otherwise the
+//! comparison names the reason. Offline tracking of the same file is bit-identical run to
 //! run (`tools/spacepose/tests/track_cli.rs`).
 #![allow(clippy::unwrap_used)] // test helpers
 

@@ -65,15 +65,20 @@ fn acquisition_keys(list: &[AcquisitionRecord]) -> Vec<AcquisitionKey> {
         .collect()
 }
 
-/// The angle (deg) and distance (mm) between two poses.
+/// The angle (deg) and distance (mm) between two poses; the angle of the
+/// relative rotation by `atan2`, exact near zero (0 for equal quaternions,
+/// where `acos` of a rounded dot product is not).
 fn apart(a: &TelemetryPose, b: &TelemetryPose) -> (f64, f64) {
-    let [w0, x0, y0, z0] = a.q_sensor_target;
-    let [w1, x1, y1, z1] = b.q_sensor_target;
-    let dot = (w0 * w1 + x0 * x1 + y0 * y1 + z0 * z1).abs().min(1.0);
+    let q = |p: &TelemetryPose| {
+        let [w, x, y, z] = p.q_sensor_target;
+        nalgebra::Quaternion::new(w, x, y, z)
+    };
+    let rel = q(a).conjugate() * q(b);
+    let angle = 2.0 * rel.imag().norm().atan2(rel.w.abs());
     let d: f64 = (0..3)
         .map(|i| (a.p_sensor_target_m[i] - b.p_sensor_target_m[i]).powi(2))
         .sum();
-    ((2.0 * dot.acos()).to_degrees(), d.sqrt() * 1e3)
+    (angle.to_degrees(), d.sqrt() * 1e3)
 }
 
 /// Compares the recorded run with the replayed poses and acquisitions,
@@ -158,10 +163,10 @@ fn reasons(recorded: &RecordedRun, c: &Comparison) -> Vec<String> {
     if out.is_empty() && c.identical < c.matched {
         out.push(format!(
             "with the same frames and acquisitions, poses differ from frame {} (by at \
-             most {:.1e} deg, {:.1e} mm): the filter service's state replaces the \
-             tracker's own prediction when it arrives before the next frame \
-             (apply_filter_state in services/nodes/tracker/src/track.rs), and whether it \
-             does depends on scheduling; `spacepose track` on the recording runs them in \
+             most {:.1e} deg, {:.1e} mm): the remaining input that depends on timing is \
+             the filter service's state, which replaces the tracker's own prediction \
+             when it arrives before the next frame (apply_filter_state in \
+             services/nodes/tracker/src/track.rs); `spacepose track` on the recording runs them in \
              lockstep and is bit-identical",
             c.first_difference.unwrap_or_default(),
             c.max_angle_deg,

@@ -37,6 +37,7 @@ fn identical_poses_are_reproduced_in_the_recordings_numbering() {
     let c = compare(&rec, replay, vec![acquisition(2)]);
     assert!(c.reproduced(), "{c:?}");
     assert_eq!((c.matched, c.identical, c.first_difference), (2, 2, None));
+    assert_eq!((c.max_angle_deg, c.max_position_mm), (0.0, 0.0));
     assert!(c.reasons.is_empty());
 }
 
@@ -62,12 +63,17 @@ fn differences_are_measured_and_explained() {
     assert_eq!((c.matched, c.same_status, c.identical), (3, 2, 1));
     assert_eq!((c.first_difference, c.extra_in_replay), (Some(1), 1));
     assert!((c.max_position_mm - 40_000.0).abs() < 1e-6);
+    assert_eq!(c.max_angle_deg, 0.0);
     assert!(c.reasons.iter().any(|r| r.contains("acquisitions")));
     assert!(c.reasons.iter().any(|r| r.contains("not recorded")));
     // Same acquisitions and frames: the remaining cause is named.
     let c = compare(&rec, replay[..3].to_vec(), vec![acquisition(2)]);
     assert_eq!(c.reasons.len(), 1);
-    assert!(c.reasons[0].contains("filter service's state"), "{:?}", c.reasons);
+    assert!(
+        c.reasons[0].contains("filter service's state"),
+        "{:?}",
+        c.reasons
+    );
 }
 
 #[test]
@@ -77,4 +83,18 @@ fn a_decimated_recording_says_so() {
     assert_eq!(rec.raw_gaps(), 2);
     let c = compare(&rec, vec![pose("t", 0, "lost", 0.0)], vec![]);
     assert!(c.reasons[0].contains("decimated"), "{:?}", c.reasons);
+}
+
+#[test]
+fn a_small_rotation_is_measured_exactly() {
+    let rec = recorded(0..1, vec![pose("t", 0, "tracking", 40.0)]);
+    let mut p = pose("t", 0, "tracking", 40.0);
+    let half = 1e-9f64.to_radians() / 2.0; // 1e-9 deg about z
+    p.q_sensor_target = [half.cos(), 0.0, 0.0, half.sin()];
+    let c = compare(&rec, vec![p], vec![acquisition(2)]);
+    assert!(
+        (c.max_angle_deg - 1e-9).abs() < 1e-15,
+        "{}",
+        c.max_angle_deg
+    );
 }
