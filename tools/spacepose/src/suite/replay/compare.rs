@@ -66,18 +66,22 @@ fn acquisition_keys(list: &[AcquisitionRecord]) -> Vec<AcquisitionKey> {
 }
 
 /// The angle (deg) and distance (mm) between two poses; the angle of the
-/// relative rotation by `atan2`, exact near zero (0 for equal quaternions,
-/// where `acos` of a rounded dot product is not).
+/// relative rotation by `atan2`, accurate near zero (`acos` of a rounded
+/// dot product is not), and 0 for equal quaternions (their product can
+/// round to a rotation of 1e-14°).
 fn apart(a: &TelemetryPose, b: &TelemetryPose) -> (f64, f64) {
+    let d: f64 = (0..3)
+        .map(|i| (a.p_sensor_target_m[i] - b.p_sensor_target_m[i]).powi(2))
+        .sum();
+    if a.q_sensor_target == b.q_sensor_target {
+        return (0.0, d.sqrt() * 1e3);
+    }
     let q = |p: &TelemetryPose| {
         let [w, x, y, z] = p.q_sensor_target;
         nalgebra::Quaternion::new(w, x, y, z)
     };
     let rel = q(a).conjugate() * q(b);
     let angle = 2.0 * rel.imag().norm().atan2(rel.w.abs());
-    let d: f64 = (0..3)
-        .map(|i| (a.p_sensor_target_m[i] - b.p_sensor_target_m[i]).powi(2))
-        .sum();
     (angle.to_degrees(), d.sqrt() * 1e3)
 }
 
