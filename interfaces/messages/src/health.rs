@@ -72,7 +72,9 @@ pub struct Counters {
     pub last_frame: u64,
     /// Frames whose per-point times were derived over the scan interval
     /// because the recording has no time field (a replay source; the
-    /// tracker's motion compensation then rests on an assumption).
+    /// tracker's motion compensation then rests on an assumption). Absent
+    /// from older telemetry JSON: read as 0 there (postcard always carries it).
+    #[serde(default)]
     pub derived_times: u64,
 }
 
