@@ -82,7 +82,9 @@ pub fn bring_up(
 ) -> Result<(Bus, HealthWatch, RunningSuite)> {
     let bus = Bus::open(
         &plan.names,
-        &format!("spacepose-{role}-{}", std::process::id()),
+        // iceoryx2 node names hold at most 24 bytes: `sp-`, a role of at
+        // most 10 bytes, and a pid of up to 7 digits (Linux pid_max 4194304).
+        &format!("sp-{role}-{}", std::process::id()),
     )
     .context("opening the iceoryx2 node")?;
     let mut watch = HealthWatch::new(&bus, &plan.names)?;

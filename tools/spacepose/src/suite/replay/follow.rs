@@ -84,7 +84,7 @@ pub fn run(
     out: &mut dyn Write,
 ) -> Result<Replayed> {
     let names = plan.names.clone();
-    let bus = Bus::open(&names, &format!("spacepose-replay-{}", std::process::id()))?;
+    let bus = Bus::open(&names, &format!("sp-replay-{}", std::process::id()))?;
     let ports = Ports {
         poses: bus.subscriber(&names.pose())?,
         acquisitions: bus.subscriber(&names.acquisition())?,
