@@ -27,6 +27,7 @@ pub mod bounds;
 pub mod deployed;
 pub mod frames;
 pub mod monte_carlo;
+pub mod nees;
 mod plot;
 mod render;
 pub mod report;

@@ -24,6 +24,7 @@ fn frame(frame: usize, status: TrackStatus, ang: f64, pos_cm: f64) -> FrameRecor
         blur_lag_deg: 0.0,
         fallback: false,
         start_up: false,
+        nees: f64::NAN,
         acquisition: None,
     }
 }

@@ -112,6 +112,16 @@ fn notes(report: &TrackingReport) -> String {
                 a.correct, a.false_accepts, a.rejected, m.silent_frames
             );
         }
+        if m.nees.frames > 0 {
+            s += &format!(
+                "{name}: NEES of the published covariance over {} frames: mean {:.1}, median {:.1} (χ²(6): 6, 5.3); above the χ² 95 % bound in {:.0} % of frames (5 % if consistent), 99.9 % bound in {:.0} %\n",
+                m.nees.frames,
+                m.nees.mean,
+                m.nees.median,
+                100.0 * m.nees.above_95,
+                100.0 * m.nees.above_999
+            );
+        }
         if m.fallback_frames > 0 {
             s += &format!(
                 "{name}: {} frames fitted as deblur after CT-NDT stalled\n",
@@ -249,6 +259,7 @@ mod tests {
             fallback_frames,
             acquisitions: Default::default(),
             silent_frames: 0,
+            nees: Default::default(),
             frames: 100,
             series: Vec::new(),
         }

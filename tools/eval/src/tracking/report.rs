@@ -71,6 +71,9 @@ pub struct FrameRecord {
     /// `deblur` mode: fitted by CT-NDT in the start-up
     /// (`TrackerConfig::start_up_blur_deg`).
     pub start_up: bool,
+    /// NEES of the published pose against the truth with its published
+    /// covariance ([`super::nees`]); NaN without a pose or a covariance.
+    pub nees: f64,
     /// The acquisition init published on this frame, when the suite
     /// acquires (`--init acquire`); it applies from the next frame.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -107,6 +110,8 @@ pub struct ModeReport {
     /// Frames published `tracking` beyond the far-off bound: silent wrong
     /// poses.
     pub silent_frames: usize,
+    /// Consistency of the published covariance over the frames with a pose.
+    pub nees: super::nees::NeesSummary,
     /// Frames run.
     pub frames: usize,
     /// Per-frame records.
@@ -177,6 +182,11 @@ pub fn record(
         let (a, d) = pose_error(&p, &truth.t_sensor_target, symmetries);
         (a, d * 100.0)
     });
+    let nees = pose
+        .and_then(|p| {
+            super::nees::pose_nees(&p, &estimate.covariance, &truth.t_sensor_target, symmetries)
+        })
+        .unwrap_or(f64::NAN);
     let w = out.map_or(nalgebra::Vector3::repeat(f64::NAN), |o| o.w_target);
     let w_err = w - truth.w_target;
     let along = truth.w_target.try_normalize(1e-12).unwrap_or_default();
@@ -204,6 +214,7 @@ pub fn record(
         blur_lag_deg: f64::NAN,
         fallback: out.is_some_and(|o| o.fallback),
         start_up: out.is_some_and(|o| o.start_up),
+        nees,
         acquisition: None,
     }
 }
@@ -231,6 +242,7 @@ pub fn summarise(series: Vec<FrameRecord>, warmup: usize) -> ModeReport {
         fallback_frames: series.iter().filter(|r| r.fallback).count(),
         acquisitions: AcquisitionCounts::of(series.iter().filter_map(|r| r.acquisition.as_ref())),
         silent_frames: series.iter().filter(|r| r.silent()).count(),
+        nees: super::nees::NeesSummary::of(series.iter().map(|r| r.nees)),
         frames: series.len(),
         series,
     }
