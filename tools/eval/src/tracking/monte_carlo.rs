@@ -8,6 +8,7 @@
 //! `crate::tables::monte_carlo` reads the files back.
 
 use super::acquisition::AcquisitionCounts;
+use super::nees::NeesSummary;
 use super::report::{FrameRecord, TrackingReport};
 use anyhow::Result;
 use rayon::prelude::*;
@@ -41,6 +42,12 @@ pub struct SeedFigures {
     pub silent: usize,
     /// Acquisitions by verdict (`--init acquire`; zero from the truth).
     pub acquisitions: AcquisitionCounts,
+    /// Median NEES of the published poses' covariance (5.3 when
+    /// consistent; NaN without a covariance).
+    pub nees_median: f64,
+    /// Share of those frames above the χ²(6) 95 % bound (0.05 when
+    /// consistent).
+    pub nees_above_95: f64,
 }
 
 /// A figure over the seeds.
@@ -137,6 +144,7 @@ pub fn figures(seed: u64, series: &[FrameRecord], warmup: usize) -> SeedFigures 
     let ang: Vec<f64> = published.iter().map(|r| r.ang_err_deg).collect();
     let pos: Vec<f64> = published.iter().map(|r| r.pos_err_cm).collect();
     let count = |s: TrackStatus| series.iter().filter(|r| r.status == s).count();
+    let nees = NeesSummary::of(series.iter().map(|r| r.nees));
     SeedFigures {
         seed,
         ang_max_deg: max(&mut ang.iter().copied()),
@@ -155,6 +163,12 @@ pub fn figures(seed: u64, series: &[FrameRecord], warmup: usize) -> SeedFigures 
             .count(),
         silent: series.iter().filter(|r| r.silent()).count(),
         acquisitions: AcquisitionCounts::of(series.iter().filter_map(|r| r.acquisition.as_ref())),
+        nees_median: nees.median_or_nan(),
+        nees_above_95: if nees.frames > 0 {
+            nees.above_95
+        } else {
+            f64::NAN
+        },
     }
 }
 
@@ -162,7 +176,7 @@ pub fn figures(seed: u64, series: &[FrameRecord], warmup: usize) -> SeedFigures 
 /// makes its spread NaN rather than vanish.
 fn spreads(per_seed: &[SeedFigures]) -> BTreeMap<String, Spread> {
     let column = |f: fn(&SeedFigures) -> f64| per_seed.iter().map(f).collect::<Vec<_>>();
-    let columns: [(&str, Vec<f64>); 12] = [
+    let columns: [(&str, Vec<f64>); 14] = [
         ("ang_max_deg", column(|s| s.ang_max_deg)),
         ("ang_mean_deg", column(|s| s.ang_mean_deg)),
         (
@@ -181,6 +195,8 @@ fn spreads(per_seed: &[SeedFigures]) -> BTreeMap<String, Spread> {
             column(|s| s.acquisitions.false_accepts as f64),
         ),
         ("rejected", column(|s| s.acquisitions.rejected as f64)),
+        ("nees_median", column(|s| s.nees_median)),
+        ("nees_above_95", column(|s| s.nees_above_95)),
     ];
     columns
         .into_iter()

@@ -47,6 +47,16 @@ fn a_run_counts_its_start_up_and_its_failures() {
     assert!((f.ang_mean_deg - 31.0 / 5.0).abs() < 1e-12);
     assert_eq!(f.pos_max_cm, 60.0);
     assert_eq!((f.lost, f.degraded, f.diverged, f.silent), (1, 1, 4, 2));
+    assert!(
+        f.nees_median.is_nan() && f.nees_above_95.is_nan(),
+        "no covariance"
+    );
+    let mut with_nees = series.clone();
+    for (r, nees) in with_nees.iter_mut().zip([1.0, 4.0, 20.0, 30.0, 5.0]) {
+        r.nees = nees;
+    }
+    let f = figures(9, &with_nees, 1);
+    assert_eq!((f.nees_median, f.nees_above_95), (5.0, 0.4));
     let warm = figures(9, &series[..2], 1);
     assert_eq!(
         (warm.ang_max_deg, warm.ang_max_after_warmup_deg),

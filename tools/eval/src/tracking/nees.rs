@@ -62,6 +62,15 @@ pub struct NeesSummary {
 }
 
 impl NeesSummary {
+    /// The median, NaN when no frame was counted.
+    pub fn median_or_nan(&self) -> f64 {
+        if self.frames > 0 {
+            self.median
+        } else {
+            f64::NAN
+        }
+    }
+
     /// The summary of `values` (non-finite ones skipped).
     pub fn of(values: impl IntoIterator<Item = f64>) -> Self {
         let mut v: Vec<f64> = values.into_iter().filter(|x| x.is_finite()).collect();
