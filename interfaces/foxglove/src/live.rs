@@ -11,7 +11,7 @@
 
 use crate::cloud::{point_cloud_every, point_step};
 use crate::error::RecordError;
-use crate::log::{Logger, keeps_frame};
+use crate::log::{Logger, keeps_cloud};
 use crate::pose::{SensorPose, poses_in_frame};
 use crate::scene::TargetMesh;
 use crate::stamp::log_time_ns;
@@ -19,7 +19,7 @@ use crate::topics;
 use foxglove::messages::PosesInFrame;
 use foxglove::websocket::{Capability, ChannelView, Client, ServerListener};
 use foxglove::{Channel, Context, PartialMetadata, WebSocketServer, WebSocketServerHandle};
-use spacepose_messages::{Cloud, Message, Topic};
+use spacepose_messages::{Cloud, Message};
 use std::collections::VecDeque;
 use std::net::{IpAddr, SocketAddr};
 use std::sync::Arc;
@@ -181,12 +181,11 @@ impl LiveView {
     /// # Errors
     /// The header could not be written as JSON.
     pub fn cloud(&mut self, cloud: Cloud<'_>) -> Result<bool, RecordError> {
-        let every = if cloud.topic == Topic::RawCloud {
-            self.options.raw_cloud_every
-        } else {
-            self.options.cloud_every
-        };
-        if !keeps_frame(every, cloud.header.sequence) {
+        if !keeps_cloud(
+            &cloud,
+            self.options.raw_cloud_every,
+            self.options.cloud_every,
+        ) {
             self.stats.clouds_skipped += 1;
             return Ok(false);
         }

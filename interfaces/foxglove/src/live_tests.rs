@@ -8,7 +8,7 @@ use foxglove::Decode;
 use foxglove::messages::{PointCloud, PoseInFrame, SceneUpdate};
 use serde_json::{Value, json};
 use spacepose_geometry::Point;
-use spacepose_messages::{CloudHeader, Name, PoseEstimate};
+use spacepose_messages::{CloudHeader, Name, PoseEstimate, Topic};
 use std::collections::BTreeMap;
 use std::net::TcpStream;
 use std::time::{Duration, Instant};

@@ -19,9 +19,16 @@ use spacepose_messages::telemetry::{
 use spacepose_messages::{Cloud, FilterState, Message, PoseEstimate, Topic, TruthMsg};
 use std::sync::Arc;
 
-/// Whether the frame `sequence` is kept when every `every`-th frame is (0: none).
-pub(crate) fn keeps_frame(every: u64, sequence: u64) -> bool {
-    every != 0 && sequence.is_multiple_of(every)
+/// Whether `cloud` is kept when every `raw_every`-th raw cloud and every
+/// `cloud_every`-th cropped cloud is (by sequence; 0: none): the one frame
+/// decimation of the file and the live view.
+pub(crate) fn keeps_cloud(cloud: &Cloud<'_>, raw_every: u64, cloud_every: u64) -> bool {
+    let every = if cloud.topic == Topic::RawCloud {
+        raw_every
+    } else {
+        cloud_every
+    };
+    every != 0 && cloud.header.sequence.is_multiple_of(every)
 }
 
 /// The channels of a context and the log-time bookkeeping.

@@ -2,10 +2,10 @@
 
 use crate::cloud::point_cloud;
 use crate::error::RecordError;
-use crate::log::{Logger, keeps_frame};
+use crate::log::{Logger, keeps_cloud};
 use crate::scene::TargetMesh;
 use foxglove::{Context, McapAttachment, McapCompression, McapWriteOptions, McapWriterHandle};
-use spacepose_messages::{Cloud, Message, Topic};
+use spacepose_messages::{Cloud, Message};
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
@@ -119,12 +119,11 @@ impl Recorder {
     /// # Errors
     /// The header could not be written as JSON.
     pub fn cloud(&mut self, cloud: Cloud<'_>) -> Result<bool, RecordError> {
-        let every = if cloud.topic == Topic::RawCloud {
-            self.options.raw_cloud_every
-        } else {
-            self.options.cloud_every
-        };
-        if !keeps_frame(every, cloud.header.sequence) {
+        if !keeps_cloud(
+            &cloud,
+            self.options.raw_cloud_every,
+            self.options.cloud_every,
+        ) {
             self.stats.clouds_skipped += 1;
             return Ok(false);
         }

@@ -2,7 +2,7 @@ use super::*;
 use foxglove::Decode;
 use foxglove::messages::{PointCloud, PoseInFrame};
 use spacepose_geometry::Point;
-use spacepose_messages::{CloudHeader, Health, Name, PoseEstimate, TruthMsg};
+use spacepose_messages::{CloudHeader, Health, Name, PoseEstimate, Topic, TruthMsg};
 
 /// (topic, schema name, log time, data) of every message of the file.
 fn read(path: &Path) -> Vec<(String, String, u64, Vec<u8>)> {
