@@ -62,13 +62,13 @@ impl Ports {
     }
 }
 
-/// True when every tracker of the recording has a pose of the last frame.
-fn last_frame_posed(r: &Replayed, recorded: &RecordedRun) -> bool {
-    let last = recorded.raw_sequences.len() as u64 - 1;
-    let instances: BTreeSet<&str> = recorded.poses.iter().map(|p| p.instance.as_str()).collect();
+/// True when every tracker of the recording (`instances`) has a pose of
+/// the frame `last` or later.
+fn last_frame_posed(r: &Replayed, instances: &BTreeSet<&str>, last: u64) -> bool {
     instances.iter().all(|i| {
         r.poses
             .iter()
+            .rev()
             .any(|p| p.instance == *i && p.sequence >= last)
     })
 }
@@ -116,6 +116,8 @@ fn follow(
     waiter.attach(&ports.raw)?;
     let mut r = Replayed::default();
     let total = recorded.raw_sequences.len();
+    let last = total.saturating_sub(1) as u64;
+    let instances: BTreeSet<&str> = recorded.poses.iter().map(|p| p.instance.as_str()).collect();
     let start = Instant::now();
     let mut last_news = Instant::now();
     let mut done_at: Option<Instant> = None;
@@ -138,7 +140,7 @@ fn follow(
         }
         sup.step(out)?;
         let all_out = r.raw_clouds >= total;
-        match (all_out && last_frame_posed(&r, recorded), done_at) {
+        match (all_out && last_frame_posed(&r, &instances, last), done_at) {
             (true, None) => done_at = Some(Instant::now()),
             (true, Some(t)) if t.elapsed() >= SETTLE => return Ok(r),
             (false, _) => done_at = None,
