@@ -4,6 +4,7 @@ use crate::error::TrackError;
 use crate::held_rotation::HeldRotationConfig;
 pub use crate::loss::LossConfig;
 use crate::mode::TrackingMode;
+use crate::visibility::VisibilityConfig;
 use serde::{Deserialize, Serialize};
 use spacepose_filter::FilterConfig;
 use spacepose_registration::{IcpParams, NdtParams};
@@ -134,6 +135,9 @@ pub struct TrackerConfig {
     pub filter: FilterConfig,
     /// Degraded / lost thresholds.
     pub loss: LossConfig,
+    /// The visibility gate: points behind the model at the prediction are
+    /// dropped before registration (`crate::visibility`; not in the paper).
+    pub visibility: VisibilityConfig,
 }
 
 /// How `ct-ndt` treats the start pose `T^s` of a scan.
@@ -231,6 +235,7 @@ impl Default for TrackerConfig {
             // would reject good frames. The filter's own gate is therefore off.
             filter: FilterConfig::default(),
             loss: LossConfig::default(),
+            visibility: VisibilityConfig::default(),
         }
     }
 }
@@ -312,7 +317,8 @@ impl TrackerConfig {
         self.filter
             .validate()
             .map_err(|e| TrackError::InvalidConfig(e.to_string()))?;
-        self.loss.validate()
+        self.loss.validate()?;
+        self.visibility.validate()
     }
 }
 

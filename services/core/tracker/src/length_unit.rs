@@ -15,7 +15,8 @@
 //! convergence step, the voxel leaf, the model spacing, and the position
 //! limits of the loss checks (a centre of mass moves with the size).
 //!
-//! Sensor lengths do not scale: point noise, range gates, and the
+//! Sensor lengths do not scale: point noise, range gates, the visibility
+//! gate's tolerance (`crate::visibility`), and the
 //! lever-arm holds of the degeneracy handling, which compare how far a
 //! rotation moves the surface against the range noise (2 cm), not against
 //! the cell. Scaling them too held the roll of the 17 m telescope test

@@ -1,7 +1,8 @@
 //! The tracking loop of seed 000 §3.2-3.3 as a library (no bus): each lidar
 //! frame (cropped raw points) goes through the one frame path
-//! ([`pipeline`]: motion compensation in the modes that compensate, then
-//! the voxel filter), is registered against the smoothed NDT map (or the
+//! ([`visibility`]: the points behind the model at the prediction are
+//! dropped; [`pipeline`]: motion compensation in the modes that compensate,
+//! then the voxel filter), is registered against the smoothed NDT map (or the
 //! ICP model), and fused into the relative-motion filter, whose prediction
 //! seeds the next frame.
 //!
@@ -22,6 +23,7 @@
 
 mod assess;
 pub mod config;
+mod depth_image;
 mod dispatch;
 pub mod error;
 pub mod held_rotation;
@@ -35,6 +37,7 @@ pub mod pipeline;
 mod start_up;
 pub mod status;
 pub mod tracker;
+pub mod visibility;
 
 pub use config::{CtStart, LossConfig, TrackerConfig};
 pub use error::TrackError;
@@ -46,8 +49,11 @@ pub use output::{Timings, TrackOutput};
 pub use pipeline::{FramePipeline, Prepared};
 pub use status::TrackStatus;
 pub use tracker::Tracker;
+pub use visibility::{VisibilityConfig, VisibilityModel};
 
 #[cfg(test)]
 mod sim_tests;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod visibility_sim_tests;

@@ -9,6 +9,7 @@
 //! `icp` by a mode command builds it then, before its next frame.
 
 use crate::error::TrackError;
+use crate::visibility::VisibilityModel;
 use nalgebra::Vector3;
 use spacepose_registration::{IcpModel, NdtMap, NdtMapParams};
 use std::sync::{Arc, OnceLock};
@@ -27,6 +28,9 @@ pub struct TrackingModel {
     /// The target's calibrated loss thresholds (from its package); they
     /// fill the `loss` keys a configuration leaves unset.
     pub thresholds: TargetThresholds,
+    /// The model cloud thinned to one point per NDT cell, for the
+    /// visibility gate (`crate::visibility`).
+    pub visibility: Arc<VisibilityModel>,
     icp: Arc<LazyIcp>,
 }
 
@@ -84,7 +88,9 @@ impl TrackingModel {
 
     /// Wraps a map loaded from disk; the ICP model follows on first use.
     pub fn from_map(map: NdtMap, model_target: &[Vector3<f64>]) -> Self {
+        let spacing = map.params().min_cell_size_m / 3.0;
         Self {
+            visibility: Arc::new(VisibilityModel::new(model_target, spacing)),
             map: Arc::new(map),
             thresholds: TargetThresholds::UNCALIBRATED,
             icp: Arc::new(LazyIcp {

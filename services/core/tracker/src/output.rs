@@ -62,6 +62,9 @@ pub struct TrackOutput {
     /// being still too uncertain to compensate the scan
     /// ([`crate::TrackerConfig::start_up_blur_deg`]).
     pub start_up: bool,
+    /// Points the visibility gate found behind the model at the prediction
+    /// and dropped (`crate::visibility`): mirror ghosts of reflections.
+    pub points_behind: usize,
 }
 
 impl TrackOutput {
@@ -87,6 +90,7 @@ impl TrackOutput {
             },
             fallback: false,
             start_up: false,
+            points_behind: 0,
         }
     }
 

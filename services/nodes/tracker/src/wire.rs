@@ -118,6 +118,7 @@ mod tests {
             },
             fallback: false,
             start_up: false,
+            points_behind: 0,
         };
         fill_estimate(&mut e, &out);
         assert_eq!(e.wire_status().unwrap(), WireStatus::Degraded);

@@ -20,6 +20,7 @@ fn frame(frame: usize, status: TrackStatus, ang: f64, pos_cm: f64) -> FrameRecor
         weakest_lever_arm_m: 0.1,
         points_in: 1000,
         points_used: 900,
+        points_behind: 0,
         reason: String::new(),
         blur_lag_deg: 0.0,
         fallback: false,

@@ -56,6 +56,11 @@ pub struct FrameRecord {
     pub points_in: usize,
     /// Points after pre-processing.
     pub points_used: usize,
+    /// Points the visibility gate dropped as lying behind the model at the
+    /// prediction (`spacepose_tracker::visibility`); 0 in reports written
+    /// before the gate.
+    #[serde(default)]
+    pub points_behind: usize,
     /// Why the frame is degraded or lost (empty when tracking).
     pub reason: String,
     /// Scan blur: the angle the true attitude turns between the mean time
@@ -210,6 +215,7 @@ pub fn record(
         weakest_lever_arm_m: reg.map_or(f64::NAN, |r| r.weakest_lever_arm_m),
         points_in: frame.points.len(),
         points_used: out.map_or(0, |o| o.points_used),
+        points_behind: out.map_or(0, |o| o.points_behind),
         reason: out.map_or_else(String::new, |o| o.reason.clone()),
         blur_lag_deg: f64::NAN,
         fallback: out.is_some_and(|o| o.fallback),

@@ -27,6 +27,8 @@ pub(super) struct Measured {
     /// with two poses.
     pub(super) t_target_sensor_start: Option<Pose>,
     pub(super) preprocess_ms: f64,
+    /// Points the visibility gate dropped.
+    pub(super) points_behind: usize,
     /// Registration, the fallback included.
     pub(super) registration_ms: f64,
 }
@@ -72,6 +74,9 @@ impl Tracker {
             .pipeline
             .prepare(points, mode, c.ct_ndt_min_points, prediction)
             .map_err(|e| Missing::because(e.to_string()))?;
+        let (cloud, points_behind) = self
+            .visible(cloud, compensated, prediction, scan)
+            .map_err(|e| Missing::because(e.to_string()))?;
         let preprocess_ms = ms(pre);
         if cloud.len() < self.config.loss.min_points {
             let reason = format!(
@@ -113,8 +118,33 @@ impl Tracker {
             mode,
             t_target_sensor_start: start,
             preprocess_ms,
+            points_behind,
             registration_ms: ms(reg_start),
         })
+    }
+
+    /// The visibility gate ([`crate::visibility`]) on a prepared cloud: the
+    /// points kept and how many were dropped.
+    fn visible(
+        &self,
+        cloud: Vec<Point>,
+        at_scan_end: bool,
+        prediction: &Prediction,
+        scan: &ScanTimes,
+    ) -> Result<(Vec<Point>, usize), crate::TrackError> {
+        let gated =
+            self.model
+                .visibility
+                .gate(cloud, at_scan_end, prediction, &self.config.visibility)?;
+        if gated.overruled {
+            tracing::debug!(
+                t = scan.end_s,
+                behind = gated.behind,
+                "visibility gate overruled: most points lie behind the model at the prediction"
+            );
+            return Ok((gated.points, 0));
+        }
+        Ok((gated.points, gated.behind))
     }
 
     /// [`TrackerConfig::ct_ndt_stall_fallback`]: when CT-NDT stalled, the
@@ -139,6 +169,7 @@ impl Tracker {
             return None;
         }
         let cloud = self.pipeline.compensated(points, prediction).ok()?;
+        let (cloud, _) = self.visible(cloud, true, prediction, scan).ok()?;
         match self
             .dispatch(plan)
             .register(&cloud, true, prediction, last, scan)

@@ -189,6 +189,7 @@ impl Tracker {
         let mut out = self.assess(registration, fitted, &prediction, scan_end, counts)?;
         out.fallback = m.fallback;
         out.start_up = m.mode != self.config.mode;
+        out.points_behind = m.points_behind;
         if out.status == TrackStatus::Tracking && scan_w.is_some() {
             self.scan_w_target = scan_w;
         }
@@ -287,6 +288,7 @@ impl Tracker {
             timings: Timings::default(),
             fallback: false,
             start_up: false,
+            points_behind: 0,
         })
     }
 
