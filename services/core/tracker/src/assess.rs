@@ -54,18 +54,21 @@ pub(crate) fn quality_issues(c: &TrackerConfig, r: &Registration) -> Vec<String>
 }
 
 /// The reason to doubt a measurement that jumps from the prediction by
-/// more than `loss.max_innovation_*`.
+/// more than `limit_rot_deg` (the track's limit, [`crate::innovation`]) or
+/// `loss.max_innovation_pos_m`.
 pub(crate) fn inconsistency(
     l: &LossConfig,
+    limit_rot_deg: f64,
     innovation_rot_deg: f64,
     innovation_pos_m: f64,
 ) -> Option<String> {
-    (innovation_rot_deg > l.max_innovation_rot_deg || innovation_pos_m > l.max_innovation_pos_m)
-        .then(|| {
-            format!(
-                "inconsistent with prediction ({innovation_rot_deg:.1} deg, {innovation_pos_m:.3} m)"
-            )
-        })
+    (innovation_rot_deg > limit_rot_deg || innovation_pos_m > l.max_innovation_pos_m).then(|| {
+        format!(
+            "inconsistent with prediction ({innovation_rot_deg:.1} deg, {innovation_pos_m:.3} m; \
+             limits {limit_rot_deg:.1} deg, {:.3} m)",
+            l.max_innovation_pos_m
+        )
+    })
 }
 
 /// The measurement covariance `[rot; trans]` with its attitude inflated by

@@ -27,6 +27,7 @@ mod depth_image;
 mod dispatch;
 pub mod error;
 pub mod held_rotation;
+pub mod innovation;
 pub mod length_unit;
 mod loss;
 pub mod measurement;

@@ -2,6 +2,7 @@
 //! its defaults and its checks.
 
 use crate::error::TrackError;
+use crate::innovation::InnovationLimitConfig;
 use serde::{Deserialize, Serialize};
 
 /// When a frame counts as degraded, and when the track counts as lost.
@@ -51,6 +52,10 @@ pub struct LossConfig {
     pub max_final_increment_m: f64,
     /// Degraded frames in a row after which the track is declared lost.
     pub max_consecutive_degraded: u32,
+    /// The attitude innovation limit that follows the track once its rate
+    /// is known: a multiple of its recent innovations, between a floor and
+    /// `max_innovation_rot_deg` ([`crate::innovation`]).
+    pub innovation: InnovationLimitConfig,
 }
 
 impl Default for LossConfig {
@@ -66,6 +71,7 @@ impl Default for LossConfig {
             max_final_increment_deg: 1.0,
             max_final_increment_m: 0.05,
             max_consecutive_degraded: 5,
+            innovation: InnovationLimitConfig::default(),
         }
     }
 }
@@ -135,6 +141,9 @@ impl LossConfig {
                 "loss.max_consecutive_degraded must be >= 1".into(),
             ));
         }
-        Ok(())
+        match l.innovation.problem() {
+            Some(p) => Err(TrackError::InvalidConfig(p)),
+            None => Ok(()),
+        }
     }
 }

@@ -105,3 +105,42 @@ fn a_doubted_frame_publishes_the_filter_estimate_where_it_seeds_the_registration
         assert!(out.covariance.is_some());
     }
 }
+
+#[test]
+fn a_jump_the_track_has_never_made_is_doubted_below_the_absolute_limit() {
+    let (target, model) = fixture();
+    let jump = so3::exp(&Vector3::new(0.0, 6f64.to_radians(), 0.0));
+    for enabled in [true, false] {
+        let mut config = TrackerConfig::with_mode(TrackingMode::Ndt);
+        config.loss.innovation.enabled = enabled;
+        let mut tracker = Tracker::new(config, model.clone()).unwrap();
+        tracker
+            .initialize(0.0, &truth(0.0, 0.5), Vector3::zeros(), Vector3::zeros())
+            .unwrap();
+        for k in 1..=8 {
+            let t = 0.1 * k as f64;
+            let out = tracker
+                .process(&target.frame(&truth(t, 0.5), 0.02), t - 0.1, t)
+                .unwrap();
+            assert_eq!(
+                out.status,
+                TrackStatus::Tracking,
+                "frame {k}: {}",
+                out.reason
+            );
+        }
+        let t = 0.9;
+        let true_pose = truth(t, 0.5);
+        let jumped = Pose::new(true_pose.rotation * jump, true_pose.translation);
+        let out = tracker
+            .process(&target.frame(&jumped, 0.02), t - 0.1, t)
+            .unwrap();
+        assert!(out.innovation_rot_deg > 4.0, "{}", out.innovation_rot_deg);
+        let expected = if enabled {
+            TrackStatus::Degraded
+        } else {
+            TrackStatus::Tracking
+        };
+        assert_eq!(out.status, expected, "enabled {enabled}: {}", out.reason);
+    }
+}

@@ -21,6 +21,7 @@ fn frame(frame: usize, status: TrackStatus, ang: f64, pos_cm: f64) -> FrameRecor
         points_in: 1000,
         points_used: 900,
         points_behind: 0,
+        innovation_rot_deg: f64::NAN,
         reason: String::new(),
         blur_lag_deg: 0.0,
         fallback: false,

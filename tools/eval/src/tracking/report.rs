@@ -57,10 +57,11 @@ pub struct FrameRecord {
     /// Points after pre-processing.
     pub points_used: usize,
     /// Points the visibility gate dropped as lying behind the model at the
-    /// prediction (`spacepose_tracker::visibility`); 0 in reports written
-    /// before the gate.
-    #[serde(default)]
+    /// prediction (`spacepose_tracker::visibility`).
     pub points_behind: usize,
+    /// Attitude difference between the registration and the filter's
+    /// prediction (deg; NaN without a registration).
+    pub innovation_rot_deg: f64,
     /// Why the frame is degraded or lost (empty when tracking).
     pub reason: String,
     /// Scan blur: the angle the true attitude turns between the mean time
@@ -216,6 +217,7 @@ pub fn record(
         points_in: frame.points.len(),
         points_used: out.map_or(0, |o| o.points_used),
         points_behind: out.map_or(0, |o| o.points_behind),
+        innovation_rot_deg: out.map_or(f64::NAN, |o| o.innovation_rot_deg),
         reason: out.map_or_else(String::new, |o| o.reason.clone()),
         blur_lag_deg: f64::NAN,
         fallback: out.is_some_and(|o| o.fallback),

@@ -23,6 +23,8 @@ pub(super) struct Measured {
     pub(super) fallback: bool,
     /// The frame's registration (`crate::start_up::frame_plan`).
     pub(super) mode: TrackingMode,
+    /// The frame is in the start-up (`crate::start_up::frame_plan`).
+    pub(super) start_up: bool,
     /// `t_target_sensor` at the scan start, when CT-NDT fitted the scan
     /// with two poses.
     pub(super) t_target_sensor_start: Option<Pose>,
@@ -116,6 +118,7 @@ impl Tracker {
             points_used,
             fallback,
             mode,
+            start_up: plan.start_up,
             t_target_sensor_start: start,
             preprocess_ms,
             points_behind,

@@ -8,6 +8,7 @@ use crate::config::TrackerConfig;
 use crate::dispatch::{Dispatch, LastPose, ndt_params};
 use crate::error::TrackError;
 use crate::held_rotation::HeldRotation;
+use crate::innovation::InnovationHistory;
 use crate::measurement::{covariance_sensor_target, measurement_information};
 use crate::mode::TrackingMode;
 use crate::model::TrackingModel;
@@ -41,6 +42,9 @@ pub struct Tracker {
     /// CT-NDT fitted with two poses and was tracked; reset at each
     /// (re)initialisation (`crate::start_up`).
     scan_w_target: Option<Vector3<f64>>,
+    /// The recent attitude innovations the limit follows
+    /// (`crate::innovation`); reset at each (re)initialisation.
+    innovations: InnovationHistory,
 }
 
 impl Tracker {
@@ -67,6 +71,7 @@ impl Tracker {
             holding: false,
             held,
             scan_w_target: None,
+            innovations: InnovationHistory::default(),
         })
     }
 
@@ -133,6 +138,7 @@ impl Tracker {
         self.holding = false;
         self.held.reset();
         self.scan_w_target = None;
+        self.innovations.reset();
         Ok(())
     }
 
@@ -185,7 +191,7 @@ impl Tracker {
         let scan_w = scan_rate(m.t_target_sensor_start.as_ref(), &m.registration, &scan);
         let registration = self.held.follow(scan_end, m.registration);
         let counts = (points.len(), m.points_used);
-        let fitted = (m.mode, m.compensated);
+        let fitted = (m.mode, m.compensated, m.start_up);
         let mut out = self.assess(registration, fitted, &prediction, scan_end, counts)?;
         out.fallback = m.fallback;
         out.start_up = m.mode != self.config.mode;
@@ -240,7 +246,7 @@ impl Tracker {
     fn assess(
         &mut self,
         registration: Registration,
-        (mode, compensated): (TrackingMode, bool),
+        (mode, compensated, start_up): (TrackingMode, bool, bool),
         prediction: &Prediction,
         t: f64,
         (points_in, points_used): (usize, usize),
@@ -253,8 +259,13 @@ impl Tracker {
         let covariance = covariance_sensor_target(&registration.t_target_sensor, &information)
             .map(|c| attitude_scaled(&self.config, mode, c, compensated));
         let mut reasons = quality_issues(&self.config, &registration);
+        let loss = &self.config.loss;
+        let limit =
+            self.innovations
+                .limit_deg(&loss.innovation, loss.max_innovation_rot_deg, start_up);
         reasons.extend(inconsistency(
-            &self.config.loss,
+            loss,
+            limit,
             innovation_rot_deg,
             innovation_pos_m,
         ));
@@ -268,6 +279,10 @@ impl Tracker {
             }
         }
         let status = self.status_after(&mut reasons);
+        if status == TrackStatus::Tracking && !start_up {
+            self.innovations
+                .record(&self.config.loss.innovation, innovation_rot_deg);
+        }
         let (t_sensor_target, covariance) =
             published(self.config.mode, status, measured, covariance, prediction);
         self.last = Some(LastPose { t, t_sensor_target });
