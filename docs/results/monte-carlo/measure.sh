@@ -6,7 +6,7 @@
 # matching, acquire on the frames and reacquire after a loss). `spacepose eval tables`
 # turns them into the table of docs/results.md.
 #   docs/results/monte-carlo/measure.sh <spacepose binary>
-# Each report takes 5-15 minutes on this project's 2-core machine.
+# Each report takes 70-160 s on this project's 2-core machine (the twelve: about 20 minutes).
 set -euo pipefail
 bin=$(realpath "$1")
 here=docs/results/monte-carlo
