@@ -241,6 +241,24 @@ impl RelativeMotionFilter {
         self.fuse(pending)
     }
 
+    /// The innovation of a measurement against the prediction at `t`,
+    /// without fusing it. Its `mahalanobis2` is the NIS: χ²(6) when the
+    /// measurement covariance (as the filter scales it) and the filter's
+    /// own are consistent.
+    ///
+    /// # Errors
+    /// As [`Self::update`].
+    pub fn innovation(
+        &self,
+        t: f64,
+        measured_pose: &Pose,
+        measurement_covariance: Option<&Matrix6<f64>>,
+    ) -> Result<UpdateOutcome, FilterError> {
+        Ok(self
+            .check(t, measured_pose, measurement_covariance)?
+            .outcome)
+    }
+
     fn fuse(&mut self, mut p: Pending) -> Result<UpdateOutcome, FilterError> {
         p.predicted
             .attitude

@@ -288,3 +288,32 @@ fn restore_reproduces_the_published_estimate() {
     bad.t = f64::NAN;
     assert!(copy.restore(&bad).is_err());
 }
+
+/// The NIS of measurements drawn from the stated noise follows χ²(6)
+/// (mean 6); measurements 3 times noisier than stated give about 9 times
+/// that. `innovation` is the update's own figure and changes nothing.
+#[test]
+fn nis_of_consistent_measurements_averages_six() {
+    let truth = Truth::new();
+    let (s_rot, s_pos) = (0.5f64.to_radians(), 0.01);
+    let mean_nis = |k_noise: f64, seed: u64| {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut f = converged(&truth, 20, &mut rng);
+        let mut sum = 0.0;
+        for k in 21..=420 {
+            let t = k as f64;
+            let m = noisy(&truth.pose(t), &mut rng, k_noise * s_rot, k_noise * s_pos);
+            let before = f.estimate().unwrap();
+            let nis = f.innovation(t, &m, None).unwrap().mahalanobis2;
+            assert_eq!(f.estimate().unwrap(), before);
+            let out = f.force_update(t, &m, None).unwrap();
+            assert_eq!(out.mahalanobis2, nis);
+            sum += nis;
+        }
+        sum / 400.0
+    };
+    let consistent = mean_nis(1.0, 21);
+    assert!((consistent - 6.0).abs() < 0.8, "mean NIS {consistent}");
+    let over = mean_nis(3.0, 22);
+    assert!(over > 30.0, "mean NIS {over} with 3× the stated noise");
+}

@@ -43,6 +43,10 @@ pub struct TrackOutput {
     pub innovation_rot_deg: f64,
     /// Position difference between the measurement and the prediction (m).
     pub innovation_pos_m: f64,
+    /// Normalised innovation squared of the measurement against the
+    /// prediction, with the covariance the filter fuses (χ²(6) when both
+    /// are consistent); NaN without a measurement.
+    pub nis: f64,
     /// Filter's angular velocity after the frame, target frame (rad/s).
     pub w_target: Vector3<f64>,
     /// Filter's velocity after the frame, sensor frame (m/s).
@@ -80,6 +84,7 @@ impl TrackOutput {
             registration: None,
             innovation_rot_deg: f64::NAN,
             innovation_pos_m: f64::NAN,
+            nis: f64::NAN,
             w_target: prediction.w_target,
             v_sensor: prediction.v_sensor,
             points_in,

@@ -107,6 +107,7 @@ mod tests {
             registration: None,
             innovation_rot_deg: 0.0,
             innovation_pos_m: 0.0,
+            nis: f64::NAN,
             w_target: Vector3::zeros(),
             v_sensor: Vector3::zeros(),
             points_in: 1000,

@@ -22,7 +22,7 @@ use spacepose_geometry::Point;
 use spacepose_ingest_node::{IngestNode, IngestServiceConfig};
 use spacepose_init_node::{InitNode, InitServiceConfig};
 use spacepose_messages::{
-    AcquisitionResult, CloudHeader, Message, Name, Names, PoseEstimate, Topic,
+    AcquisitionResult, CloudHeader, FilterState, Message, Name, Names, PoseEstimate, Topic,
 };
 use spacepose_runtime::{Envelope, LocalBus, Node, NodeInfo};
 use spacepose_tracker::{TrackOutput, TrackingModel};
@@ -50,6 +50,9 @@ pub struct Answer {
     /// Acquisitions init published on this frame (accepted or not), with
     /// [`DeployedSuite::with_init`]; they apply from the next frame on.
     pub acquisitions: Vec<AcquisitionResult>,
+    /// The filter service's state after the frame, when initialised: the
+    /// posterior the tracker's next prediction starts from.
+    pub filter_state: Option<FilterState>,
     /// Everything the nodes published for this frame, in order (the
     /// cropped cloud, the estimate, the filter state, acquisitions), for a
     /// recording.
@@ -60,6 +63,7 @@ pub struct Answer {
 pub struct DeployedSuite {
     bus: LocalBus,
     tracker: usize,
+    filter: usize,
     init: Option<usize>,
 }
 
@@ -87,10 +91,11 @@ impl DeployedSuite {
             Name::new("tracker")?,
             t.max_points,
         )?);
-        bus.add(FilterNode::new(configs.filter.clone(), &info("filter")?)?);
+        let filter = bus.add(FilterNode::new(configs.filter.clone(), &info("filter")?)?);
         Ok(DeployedSuite {
             bus,
             tracker,
+            filter,
             init: None,
         })
     }
@@ -135,6 +140,11 @@ impl DeployedSuite {
             .bus
             .node::<TrackerNode>(self.tracker)
             .and_then(|n| n.last_output().cloned());
+        let filter_state = self
+            .bus
+            .node::<FilterNode>(self.filter)
+            .map(FilterNode::filter_state)
+            .filter(|s| s.initialized != 0);
         sent.extend(self.finish_acquisition());
         let acquisitions = sent
             .iter()
@@ -147,6 +157,7 @@ impl DeployedSuite {
             estimate,
             output,
             acquisitions,
+            filter_state,
             sent,
         })
     }

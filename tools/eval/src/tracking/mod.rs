@@ -25,6 +25,7 @@ pub mod acquisition;
 mod args;
 pub mod bounds;
 pub mod deployed;
+pub mod filter_score;
 pub mod frames;
 pub mod monte_carlo;
 pub mod nees;
@@ -126,6 +127,7 @@ fn run_frames(
                 let output = answer.output.as_ref();
                 let mut r = report::record(frame, k as usize, &answer.estimate, output, symmetries);
                 r.blur_lag_deg = lag;
+                report::score_filter(&mut r, frame, answer.filter_state.as_ref(), symmetries);
                 r.acquisition = answer.acquisitions.last().map(|a| {
                     let truth = &frame.truth.t_sensor_target;
                     acquisition::score(k, a, Some(truth), symmetries)

@@ -48,6 +48,15 @@ pub struct SeedFigures {
     /// Share of those frames above the χ²(6) 95 % bound (0.05 when
     /// consistent).
     pub nees_above_95: f64,
+    /// Median NEES of the filter service's posterior with its own
+    /// covariance, over the frames it fused (5.3 when consistent).
+    pub filter_nees_median: f64,
+    /// Share of those frames above the χ²(6) 95 % bound.
+    pub filter_nees_above_95: f64,
+    /// Median NIS of the registrations against the filter's predictions.
+    pub nis_median: f64,
+    /// Share of those frames above the χ²(6) 95 % bound.
+    pub nis_above_95: f64,
 }
 
 /// A figure over the seeds.
@@ -145,6 +154,8 @@ pub fn figures(seed: u64, series: &[FrameRecord], warmup: usize) -> SeedFigures 
     let pos: Vec<f64> = published.iter().map(|r| r.pos_err_cm).collect();
     let count = |s: TrackStatus| series.iter().filter(|r| r.status == s).count();
     let nees = NeesSummary::of(series.iter().map(|r| r.nees));
+    let filter_nees = NeesSummary::of(series.iter().map(|r| r.filter_nees));
+    let nis = NeesSummary::of(series.iter().map(|r| r.nis));
     SeedFigures {
         seed,
         ang_max_deg: max(&mut ang.iter().copied()),
@@ -164,11 +175,11 @@ pub fn figures(seed: u64, series: &[FrameRecord], warmup: usize) -> SeedFigures 
         silent: series.iter().filter(|r| r.silent()).count(),
         acquisitions: AcquisitionCounts::of(series.iter().filter_map(|r| r.acquisition.as_ref())),
         nees_median: nees.median_or_nan(),
-        nees_above_95: if nees.frames > 0 {
-            nees.above_95
-        } else {
-            f64::NAN
-        },
+        nees_above_95: nees.above_95_or_nan(),
+        filter_nees_median: filter_nees.median_or_nan(),
+        filter_nees_above_95: filter_nees.above_95_or_nan(),
+        nis_median: nis.median_or_nan(),
+        nis_above_95: nis.above_95_or_nan(),
     }
 }
 
@@ -176,7 +187,7 @@ pub fn figures(seed: u64, series: &[FrameRecord], warmup: usize) -> SeedFigures 
 /// makes its spread NaN rather than vanish.
 fn spreads(per_seed: &[SeedFigures]) -> BTreeMap<String, Spread> {
     let column = |f: fn(&SeedFigures) -> f64| per_seed.iter().map(f).collect::<Vec<_>>();
-    let columns: [(&str, Vec<f64>); 14] = [
+    let columns: [(&str, Vec<f64>); 18] = [
         ("ang_max_deg", column(|s| s.ang_max_deg)),
         ("ang_mean_deg", column(|s| s.ang_mean_deg)),
         (
@@ -197,6 +208,10 @@ fn spreads(per_seed: &[SeedFigures]) -> BTreeMap<String, Spread> {
         ("rejected", column(|s| s.acquisitions.rejected as f64)),
         ("nees_median", column(|s| s.nees_median)),
         ("nees_above_95", column(|s| s.nees_above_95)),
+        ("filter_nees_median", column(|s| s.filter_nees_median)),
+        ("filter_nees_above_95", column(|s| s.filter_nees_above_95)),
+        ("nis_median", column(|s| s.nis_median)),
+        ("nis_above_95", column(|s| s.nis_above_95)),
     ];
     columns
         .into_iter()

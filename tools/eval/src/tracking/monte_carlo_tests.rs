@@ -22,11 +22,15 @@ fn frame(frame: usize, status: TrackStatus, ang: f64, pos_cm: f64) -> FrameRecor
         points_used: 900,
         points_behind: 0,
         innovation_rot_deg: f64::NAN,
+        nis: f64::NAN,
         reason: String::new(),
         blur_lag_deg: 0.0,
         fallback: false,
         start_up: false,
         nees: f64::NAN,
+        filter_ang_err_deg: f64::NAN,
+        filter_pos_err_cm: f64::NAN,
+        filter_nees: f64::NAN,
         acquisition: None,
     }
 }
@@ -56,9 +60,13 @@ fn a_run_counts_its_start_up_and_its_failures() {
     let mut with_nees = series.clone();
     for (r, nees) in with_nees.iter_mut().zip([1.0, 4.0, 20.0, 30.0, 5.0]) {
         r.nees = nees;
+        r.filter_nees = nees * 10.0;
+        r.nis = nees * 2.0;
     }
     let f = figures(9, &with_nees, 1);
     assert_eq!((f.nees_median, f.nees_above_95), (5.0, 0.4));
+    assert_eq!((f.filter_nees_median, f.filter_nees_above_95), (50.0, 0.8));
+    assert_eq!((f.nis_median, f.nis_above_95), (10.0, 0.4));
     let warm = figures(9, &series[..2], 1);
     assert_eq!(
         (warm.ang_max_deg, warm.ang_max_after_warmup_deg),

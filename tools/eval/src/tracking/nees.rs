@@ -71,6 +71,15 @@ impl NeesSummary {
         }
     }
 
+    /// The share above the 95 % bound, NaN when no frame was counted.
+    pub fn above_95_or_nan(&self) -> f64 {
+        if self.frames > 0 {
+            self.above_95
+        } else {
+            f64::NAN
+        }
+    }
+
     /// The summary of `values` (non-finite ones skipped).
     pub fn of(values: impl IntoIterator<Item = f64>) -> Self {
         let mut v: Vec<f64> = values.into_iter().filter(|x| x.is_finite()).collect();

@@ -122,6 +122,26 @@ fn notes(report: &TrackingReport) -> String {
                 100.0 * m.nees.above_999
             );
         }
+        if m.filter_nees.frames > 0 {
+            s += &format!(
+                "{name}: the filter's posterior over the {} frames it fused: error mean {:.2} / max {:.2} deg, {:.1} / {:.1} cm; NEES median {:.1}, above the 95 % bound in {:.0} %\n",
+                m.filter_nees.frames,
+                m.filter_ang_err_deg.mean,
+                m.filter_ang_err_deg.max,
+                m.filter_pos_err_cm.mean,
+                m.filter_pos_err_cm.max,
+                m.filter_nees.median,
+                100.0 * m.filter_nees.above_95
+            );
+        }
+        if m.nis.frames > 0 {
+            s += &format!(
+                "{name}: NIS of the registrations against the prediction over {} frames: median {:.1}, above the 95 % bound in {:.0} %\n",
+                m.nis.frames,
+                m.nis.median,
+                100.0 * m.nis.above_95
+            );
+        }
         if m.fallback_frames > 0 {
             s += &format!(
                 "{name}: {} frames fitted as deblur after CT-NDT stalled\n",
@@ -260,6 +280,10 @@ mod tests {
             acquisitions: Default::default(),
             silent_frames: 0,
             nees: Default::default(),
+            filter_ang_err_deg: mm(0.2, 1.2),
+            filter_pos_err_cm: mm(1.1, 9.0),
+            filter_nees: Default::default(),
+            nis: Default::default(),
             frames: 100,
             series: Vec::new(),
         }

@@ -62,6 +62,9 @@ pub struct FrameRecord {
     /// Attitude difference between the registration and the filter's
     /// prediction (deg; NaN without a registration).
     pub innovation_rot_deg: f64,
+    /// NIS of the registration against the prediction, with the covariance
+    /// the filter fuses (χ²(6) when consistent; NaN without one).
+    pub nis: f64,
     /// Why the frame is degraded or lost (empty when tracking).
     pub reason: String,
     /// Scan blur: the angle the true attitude turns between the mean time
@@ -80,6 +83,13 @@ pub struct FrameRecord {
     /// NEES of the published pose against the truth with its published
     /// covariance ([`super::nees`]); NaN without a pose or a covariance.
     pub nees: f64,
+    /// The filter service's posterior after this frame, against the truth
+    /// (deg; [`super::filter_score`]); NaN when the frame was not fused.
+    pub filter_ang_err_deg: f64,
+    /// Its position error (cm).
+    pub filter_pos_err_cm: f64,
+    /// Its NEES with the filter's own pose covariance.
+    pub filter_nees: f64,
     /// The acquisition init published on this frame, when the suite
     /// acquires (`--init acquire`); it applies from the next frame.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -118,6 +128,15 @@ pub struct ModeReport {
     pub silent_frames: usize,
     /// Consistency of the published covariance over the frames with a pose.
     pub nees: super::nees::NeesSummary,
+    /// The filter's posterior over the frames it fused: angular error (deg).
+    pub filter_ang_err_deg: MeanMax,
+    /// Its position error (cm).
+    pub filter_pos_err_cm: MeanMax,
+    /// Consistency of the filter's own covariance.
+    pub filter_nees: super::nees::NeesSummary,
+    /// NIS of the registrations against the predictions (the same χ²(6)
+    /// bounds as the NEES).
+    pub nis: super::nees::NeesSummary,
     /// Frames run.
     pub frames: usize,
     /// Per-frame records.
@@ -160,6 +179,24 @@ impl FrameRecord {
     pub fn silent(&self) -> bool {
         self.status == TrackStatus::Tracking && self.far_off()
     }
+}
+
+/// Sets the filter's figures of `r` from the service's state after the frame.
+pub fn score_filter(
+    r: &mut FrameRecord,
+    frame: &Frame,
+    state: Option<&spacepose_messages::FilterState>,
+    symmetries: &[Rotation3<f64>],
+) {
+    let f = super::filter_score::score(
+        state,
+        frame.scan_end,
+        &frame.truth.t_sensor_target,
+        symmetries,
+    );
+    r.filter_ang_err_deg = f.ang_err_deg;
+    r.filter_pos_err_cm = f.pos_err_cm;
+    r.filter_nees = f.nees;
 }
 
 /// The record of frame `index`: the estimate the tracker published, scored
@@ -218,11 +255,15 @@ pub fn record(
         points_used: out.map_or(0, |o| o.points_used),
         points_behind: out.map_or(0, |o| o.points_behind),
         innovation_rot_deg: out.map_or(f64::NAN, |o| o.innovation_rot_deg),
+        nis: out.map_or(f64::NAN, |o| o.nis),
         reason: out.map_or_else(String::new, |o| o.reason.clone()),
         blur_lag_deg: f64::NAN,
         fallback: out.is_some_and(|o| o.fallback),
         start_up: out.is_some_and(|o| o.start_up),
         nees,
+        filter_ang_err_deg: f64::NAN,
+        filter_pos_err_cm: f64::NAN,
+        filter_nees: f64::NAN,
         acquisition: None,
     }
 }
@@ -251,6 +292,10 @@ pub fn summarise(series: Vec<FrameRecord>, warmup: usize) -> ModeReport {
         acquisitions: AcquisitionCounts::of(series.iter().filter_map(|r| r.acquisition.as_ref())),
         silent_frames: series.iter().filter(|r| r.silent()).count(),
         nees: super::nees::NeesSummary::of(series.iter().map(|r| r.nees)),
+        filter_ang_err_deg: MeanMax::of(&pick(|r| r.filter_ang_err_deg, 0)),
+        filter_pos_err_cm: MeanMax::of(&pick(|r| r.filter_pos_err_cm, 0)),
+        filter_nees: super::nees::NeesSummary::of(series.iter().map(|r| r.filter_nees)),
+        nis: super::nees::NeesSummary::of(series.iter().map(|r| r.nis)),
         frames: series.len(),
         series,
     }

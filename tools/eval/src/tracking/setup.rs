@@ -4,6 +4,7 @@
 use super::deployed::{DeployedSuite, SuiteConfigs};
 use super::frames;
 use anyhow::{Context, Result};
+use spacepose_filter_node::FilterServiceConfig;
 use spacepose_ingest_node::IngestServiceConfig;
 use spacepose_init_node::InitServiceConfig;
 use spacepose_lidar_sim::FrameSource;
@@ -142,7 +143,10 @@ pub fn frame_source(config: &EvalConfig) -> Result<FrameSource> {
 }
 
 /// The services' configurations: the defaults, the target's crop, and the
-/// tracker options of `config` (the mode is set per suite).
+/// tracker options of `config` (the mode is set per suite). The filter
+/// service runs the tracker's filter configuration: the tracker restores
+/// its local filter from the service every frame, so the two must be one
+/// tuning (a `[filter]` section in `--tracker-config` reaches both).
 fn suite_configs(config: &EvalConfig) -> Result<SuiteConfigs> {
     let mut tracker = config.tracker.clone().unwrap_or_default();
     if let Some(lever) = config.min_lever_arm_m {
@@ -155,6 +159,10 @@ fn suite_configs(config: &EvalConfig) -> Result<SuiteConfigs> {
     if let Some(start) = config.ct_start {
         tracker.ct_start = start;
     }
+    let filter = FilterServiceConfig {
+        filter: tracker.filter.clone(),
+        ..FilterServiceConfig::default()
+    };
     let ingest = config
         .ingest
         .clone()
@@ -171,6 +179,6 @@ fn suite_configs(config: &EvalConfig) -> Result<SuiteConfigs> {
             tracker,
             ..TrackerServiceConfig::default()
         },
-        filter: Default::default(),
+        filter,
     })
 }

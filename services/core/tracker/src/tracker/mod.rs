@@ -258,6 +258,10 @@ impl Tracker {
         let information = measurement_information(&registration, self.config.geometric_sigma_m);
         let covariance = covariance_sensor_target(&registration.t_target_sensor, &information)
             .map(|c| attitude_scaled(&self.config, mode, c, compensated));
+        let nis = self
+            .filter
+            .innovation(t, &measured, covariance.as_ref())
+            .map_or(f64::NAN, |o| o.mahalanobis2);
         let mut reasons = quality_issues(&self.config, &registration);
         let loss = &self.config.loss;
         let limit =
@@ -296,6 +300,7 @@ impl Tracker {
             registration: Some(registration),
             innovation_rot_deg,
             innovation_pos_m,
+            nis,
             w_target: estimate.w_target,
             v_sensor: estimate.v_sensor,
             points_in,
