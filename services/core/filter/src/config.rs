@@ -13,7 +13,12 @@ pub struct FilterConfig {
     pub q_pos: f64,
     /// White-noise density on the attitude (rad²/s).
     pub q_rot: f64,
-    /// Random-walk density of the angular velocity (rad²/s³).
+    /// Random-walk density of the angular velocity (rad²/s³). 3e-5: a
+    /// torque-free tumble of an unknown inertia changes its body rate by
+    /// about (ΔI/I) ω² = 0.2 × (10°/s)² ≈ 0.006 rad/s², i.e. q_w ≈ 4e-5;
+    /// 1e-6 made the filter trust its constant rate over the measurements
+    /// once these were given their real weight
+    /// (`docs/design/measurement-covariance.md`).
     pub q_w: f64,
     /// Fixed attitude measurement noise, per axis (deg, 1σ).
     pub sigma_rot_deg: f64,
@@ -22,9 +27,11 @@ pub struct FilterConfig {
     /// Use the registration's covariance when `update` receives one; when
     /// false the fixed noise above is always used.
     pub use_registration_covariance: bool,
-    /// Factor applied to the registration's covariance (registration
-    /// Hessians tend to be over-confident). Default 1; the tracker's
-    /// `ct_ndt_attitude_covariance_scale` scales ct-ndt's attitude itself.
+    /// Factor applied to the registration's covariance here. Default 1:
+    /// the tracker already publishes its covariance scaled by its
+    /// `measurement_covariance_scale` (and ct-ndt's attitude by
+    /// `ct_ndt_attitude_covariance_scale`), so what it publishes is what
+    /// the filter fuses.
     pub registration_covariance_scale: f64,
     /// Initial attitude uncertainty, per axis (deg, 1σ).
     pub initial_sigma_rot_deg: f64,
@@ -45,7 +52,7 @@ impl Default for FilterConfig {
         Self {
             q_pos: 1e-4,
             q_rot: 1e-6,
-            q_w: 1e-6,
+            q_w: 3e-5,
             sigma_rot_deg: 1.0,
             sigma_pos_m: 0.02,
             use_registration_covariance: true,

@@ -187,12 +187,20 @@ impl Dispatch<'_> {
         )
     }
 
+    /// What the registration's covariance is multiplied by before the
+    /// filter fuses it: the tracker's `measurement_covariance_scale` times
+    /// the filter's own `registration_covariance_scale`.
+    fn measurement_scale(&self) -> f64 {
+        self.config.measurement_covariance_scale
+            * self.filter.config().registration_covariance_scale
+    }
+
     /// The prior on `T^s` ([`CtStart::FilterPrior`]): the filter's estimate
     /// at the scan start, its covariance carried through the inversion to
     /// `t_target_sensor`. The filter fuses the registration's covariance
-    /// times `filter.registration_covariance_scale`, so its covariance is
-    /// divided by that factor to be in the units of the registration's own
-    /// information, against which the prior weighs in the optimisation.
+    /// times `measurement_scale`, so its covariance is divided by that
+    /// factor to be in the units of the registration's own information,
+    /// against which the prior weighs in the optimisation.
     fn ct_start_prior(&self, scan_start: f64) -> Result<StartPrior, TrackError> {
         let at_start = self.filter.predict_at(scan_start)?;
         let a = inversion_jacobian(&at_start.pose);
@@ -200,7 +208,7 @@ impl Dispatch<'_> {
         let cov = (cov + cov.transpose()) * 0.5;
         // Undo what the measurements were inflated by before the filter.
         let d = attitude_scaling(ct_attitude_scale(self.config, self.mode)).try_inverse();
-        let scale = self.filter.config().registration_covariance_scale;
+        let scale = self.measurement_scale();
         let information = d
             .map(|d| d * cov * d)
             .and_then(|c| c.cholesky())
@@ -231,7 +239,7 @@ impl Dispatch<'_> {
         }
         let at_start = self.filter.predict_at(scan.start_s)?;
         let dt = scan.end_s - scan.start_s;
-        let scale = self.filter.config().registration_covariance_scale * weight;
+        let scale = self.measurement_scale() * weight;
         // Δt² times the velocity covariances, in the start prior's units.
         let information = |cov: Matrix3<f64>, s: f64| {
             let cov = cov * (dt * dt);

@@ -256,8 +256,11 @@ impl Tracker {
             so3::distance(&measured.rotation, &prediction.pose.rotation).to_degrees();
         let innovation_pos_m = (measured.translation - prediction.pose.translation).norm();
         let information = measurement_information(&registration, self.config.geometric_sigma_m);
-        let covariance = covariance_sensor_target(&registration.t_target_sensor, &information)
-            .map(|c| attitude_scaled(&self.config, mode, c, compensated));
+        let covariance =
+            covariance_sensor_target(&registration.t_target_sensor, &information).map(|c| {
+                attitude_scaled(&self.config, mode, c, compensated)
+                    * self.config.measurement_covariance_scale
+            });
         let nis = self
             .filter
             .innovation(t, &measured, covariance.as_ref())
