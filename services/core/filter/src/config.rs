@@ -42,10 +42,17 @@ pub struct FilterConfig {
     /// Initial angular-velocity uncertainty, per axis (deg/s, 1σ). Large:
     /// the filter starts at ω = 0 unless told otherwise (seed 000 §5.2).
     pub initial_sigma_w_degps: f64,
-    /// Gate on the squared Mahalanobis distance of the 6-D pose innovation;
-    /// `None` (default) accepts everything. χ²₆ at 99.9 % is 22.46.
+    /// Gate on the squared Mahalanobis distance of the 6-D pose innovation
+    /// (the NIS): a measurement above it is not fused. Default χ²₆ at
+    /// 99.9 %, 22.46; `inf` or `None` accepts everything. On the
+    /// development seeds it caught registrations 10-20 cm off across the
+    /// line of sight and changed nothing else
+    /// (`docs/design/filter-tuning.md`).
     pub gate_mahalanobis2: Option<f64>,
 }
+
+/// χ²(6) at 99.9 %: the default gate.
+pub const CHI2_6_999: f64 = 22.46;
 
 impl Default for FilterConfig {
     fn default() -> Self {
@@ -61,18 +68,16 @@ impl Default for FilterConfig {
             initial_sigma_pos_m: 0.05,
             initial_sigma_v_mps: 0.5,
             initial_sigma_w_degps: 30.0,
-            // Off: registration covariances are over-confident (docs/design/filter-tuning.md), and a partial `[filter]` section takes its
-            // missing keys from here, so the default must be what the
-            // services run with (a Some here used to turn the gate on in
-            // every config file that did not name it).
-            gate_mahalanobis2: None,
+            // A partial `[filter]` section takes its missing keys from
+            // here, so this is what the services run with.
+            gate_mahalanobis2: Some(CHI2_6_999),
         }
     }
 }
 
 impl FilterConfig {
-    /// Checks every value: finite, noise densities ≥ 0, standard deviations,
-    /// scale and gate > 0. Fails on NaN.
+    /// Checks every value: finite, noise densities ≥ 0, standard deviations
+    /// and scale > 0, the gate > 0 (`inf` allowed: off). Fails on NaN.
     pub fn validate(&self) -> Result<(), FilterError> {
         let non_negative = [
             ("q_pos", self.q_pos),
@@ -97,7 +102,12 @@ impl FilterConfig {
             ("initial_sigma_pos_m", self.initial_sigma_pos_m),
             ("initial_sigma_v_mps", self.initial_sigma_v_mps),
             ("initial_sigma_w_degps", self.initial_sigma_w_degps),
-            ("gate_mahalanobis2", self.gate_mahalanobis2.unwrap_or(1.0)),
+            (
+                "gate_mahalanobis2",
+                self.gate_mahalanobis2
+                    .filter(|g| *g != f64::INFINITY)
+                    .unwrap_or(1.0),
+            ),
         ];
         for (name, v) in positive {
             if !v.is_finite() || v <= 0.0 {
@@ -124,10 +134,11 @@ mod tests {
         let partial: FilterConfig = toml::from_str("q_w = 1e-8\n").unwrap();
         assert_eq!(partial.q_w, 1e-8);
         assert_eq!(partial.q_pos, c.q_pos);
-        // Absent = off, as the deploy examples say.
-        assert_eq!(partial.gate_mahalanobis2, None);
-        let gated: FilterConfig = toml::from_str("gate_mahalanobis2 = 22.46\n").unwrap();
-        assert_eq!(gated.gate_mahalanobis2, Some(22.46));
+        // Absent = the default gate, as the deploy examples say.
+        assert_eq!(partial.gate_mahalanobis2, Some(CHI2_6_999));
+        let off: FilterConfig = toml::from_str("gate_mahalanobis2 = inf\n").unwrap();
+        assert_eq!(off.gate_mahalanobis2, Some(f64::INFINITY));
+        off.validate().unwrap();
     }
 
     #[test]

@@ -9,9 +9,11 @@
 //! is known, the prediction is good to a fraction of a degree, and the
 //! track's own innovations say how good: the limit is then a multiple of
 //! their recent median, never below a floor (noise and modelling errors)
-//! nor above the absolute limit. The covariance is not used: the
-//! registration's information is far too confident (NEES 300-2,000 on the
-//! blind seeds, `docs/results.md`), so a χ² test would doubt every frame.
+//! nor above the absolute limit. The covariance is not used: even scaled
+//! to a consistent NEES, the innovations' NIS sits far under χ²(6) (the
+//! registration's errors are correlated from frame to frame,
+//! `docs/design/measurement-covariance.md`), so a χ² test would let a
+//! slide of several degrees through.
 
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;

@@ -106,13 +106,19 @@ fn a_doubted_frame_publishes_the_filter_estimate_where_it_seeds_the_registration
     }
 }
 
+/// A 6° jump is under the absolute 15° limit: the limit that follows the
+/// track doubts it, and so does the filter's χ² gate on its own (the
+/// registration's covariance is tight on this clean fixture); with both
+/// off it is fused.
 #[test]
 fn a_jump_the_track_has_never_made_is_doubted_below_the_absolute_limit() {
     let (target, model) = fixture();
     let jump = so3::exp(&Vector3::new(0.0, 6f64.to_radians(), 0.0));
-    for enabled in [true, false] {
+    let gate = spacepose_filter::FilterConfig::default().gate_mahalanobis2;
+    for (enabled, gate) in [(true, None), (false, None), (false, gate)] {
         let mut config = TrackerConfig::with_mode(TrackingMode::Ndt);
         config.loss.innovation.enabled = enabled;
+        config.filter.gate_mahalanobis2 = gate;
         let mut tracker = Tracker::new(config, model.clone()).unwrap();
         tracker
             .initialize(0.0, &truth(0.0, 0.5), Vector3::zeros(), Vector3::zeros())
@@ -136,11 +142,12 @@ fn a_jump_the_track_has_never_made_is_doubted_below_the_absolute_limit() {
             .process(&target.frame(&jumped, 0.02), t - 0.1, t)
             .unwrap();
         assert!(out.innovation_rot_deg > 4.0, "{}", out.innovation_rot_deg);
-        let expected = if enabled {
+        let expected = if enabled || gate.is_some() {
             TrackStatus::Degraded
         } else {
             TrackStatus::Tracking
         };
-        assert_eq!(out.status, expected, "enabled {enabled}: {}", out.reason);
+        assert_eq!(out.status, expected, "{enabled} {gate:?}: {}", out.reason);
+        assert_eq!(out.reason.contains("filter gate"), gate.is_some());
     }
 }

@@ -126,8 +126,8 @@ mod tests {
         let c: FilterServiceConfig = toml::from_str(&text).unwrap();
         c.filter.validate().unwrap();
         c.validate().unwrap();
-        // The example's [filter] section leaves the gate out: off.
-        assert_eq!(c.filter.gate_mahalanobis2, None);
+        // The example's [filter] section leaves the gate out: the default.
+        assert_eq!(c.filter.gate_mahalanobis2, Some(22.46));
         assert_eq!(c.filter, FilterServiceConfig::default().filter);
         let d = FilterConfig::default();
         assert_eq!(c.filter.q_pos, d.q_pos);

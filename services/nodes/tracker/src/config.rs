@@ -227,13 +227,16 @@ mod tests {
             d.ct_ndt_attitude_covariance_scale
         );
         // Its commented [tracker.filter] section, uncommented, keeps the
-        // innovation gate off (absent = off).
+        // default innovation gate (absent = the default).
         let uncommented = text
             .replace("# [tracker.filter]", "[tracker.filter]")
             .replace("# q_pos = 1e-4", "q_pos = 1e-4");
         let c: TrackerServiceConfig = toml::from_str(&uncommented).unwrap();
         assert_eq!(c.tracker.filter.q_pos, 1e-4);
-        assert_eq!(c.tracker.filter.gate_mahalanobis2, None);
+        assert_eq!(
+            c.tracker.filter.gate_mahalanobis2,
+            spacepose_filter::FilterConfig::default().gate_mahalanobis2
+        );
     }
 
     #[test]
