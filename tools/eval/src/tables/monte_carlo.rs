@@ -112,10 +112,12 @@ pub fn table(reports: &[(String, Report)]) -> String {
          over the target's symmetries); start-up included; one row per \
          report file and mode; \"max\" is each seed's largest error, then its mean / p95 / \
          max over the seeds. Acquisitions: correct / false accepts / rejected, summed over \
-         the seeds (a false accept is an accepted pose more than 10° or 50 cm off).\n\n",
+         the seeds (a false accept is an accepted pose more than 10° or 50 cm off). \
+         Consistency: each run's median NEES of the published pose and of the filter's \
+         posterior, and its median NIS, averaged over the seeds (χ²(6) median 5.3).\n\n",
     );
-    out.push_str("| file | target | scenario | configuration | mode | seeds × frames | angle max: mean / p95 / max (°) | angle mean (95 % CI) (°) | position mean / p95 of max (cm) | lost | diverged | silent | acquisitions |\n");
-    out.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    out.push_str("| file | target | scenario | configuration | mode | seeds × frames | angle max: mean / p95 / max (°) | angle mean (95 % CI) (°) | position mean / p95 of max (cm) | lost | diverged | silent | acquisitions | NEES published / filter, NIS |\n");
+    out.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (file, r) in reports {
         for (mode, m) in &r.modes {
             let get = |k: &str| m.stats.get(k).copied();
@@ -123,7 +125,7 @@ pub fn table(reports: &[(String, Report)]) -> String {
             let mean = get("ang_mean_deg");
             let sum = |f: fn(&Counts) -> usize| m.per_seed.iter().map(f).sum::<usize>();
             out.push_str(&format!(
-                "| {file} | {} | {} | {} | {mode} | {} × {} ({}) | {} / {} / {} | {} ({}-{}) | {} / {} | {} | {} | {} | {} |\n",
+                "| {file} | {} | {} | {} | {mode} | {} × {} ({}) | {} / {} / {} | {} ({}-{}) | {} / {} | {} | {} | {} | {} | {} |\n",
                 r.target,
                 r.scenario,
                 r.configuration,
@@ -142,10 +144,23 @@ pub fn table(reports: &[(String, Report)]) -> String {
                 sum(|c| c.diverged),
                 sum(|c| c.silent),
                 acquisitions(m),
+                consistency(m),
             ));
         }
     }
     out
+}
+
+/// The mean over the seeds of each run's median NEES (published, filter)
+/// and NIS; `-` for a figure the report does not have.
+fn consistency(m: &Mode) -> String {
+    let mean = |k: &str| cell(m.stats.get(k).and_then(|s| s.mean), 1);
+    format!(
+        "{} / {}, {}",
+        mean("nees_median"),
+        mean("filter_nees_median"),
+        mean("nis_median")
+    )
 }
 
 /// `correct / false accepts / rejected` over the seeds, `-` when the
