@@ -10,9 +10,10 @@
 
 use super::bounds::pose_error;
 use super::nees::pose_nees;
-use nalgebra::{Quaternion, Rotation3, UnitQuaternion, Vector3};
+use nalgebra::Rotation3;
 use spacepose_geometry::Pose;
 use spacepose_messages::FilterState;
+use spacepose_messages::convert::prediction_from_state;
 
 /// How far the state's time may be from the frame's scan end (s) to count
 /// as this frame's posterior; an older state means the frame was not fused.
@@ -39,26 +40,6 @@ impl FilterScore {
     };
 }
 
-/// The pose of `state` and its block-diagonal covariance `[rot; trans]`;
-/// `None` for a quaternion that is not finite or has no length.
-pub fn state_pose(state: &FilterState) -> Option<(Pose, [[f64; 6]; 6])> {
-    let [w, x, y, z] = state.q_sensor_target;
-    let q = Quaternion::new(w, x, y, z);
-    if !q.coords.iter().all(|v| v.is_finite()) || q.norm() < 1e-9 {
-        return None;
-    }
-    let rotation: Rotation3<f64> = UnitQuaternion::from_quaternion(q).into();
-    let pose = Pose::new(rotation, Vector3::from(state.p_sensor_target));
-    let cov = std::array::from_fn(|i| {
-        std::array::from_fn(|j| match (i < 3, j < 3) {
-            (true, true) => state.attitude_covariance[i][j],
-            (false, false) => state.position_covariance[i - 3][j - 3],
-            _ => 0.0,
-        })
-    });
-    Some((pose, cov))
-}
-
 /// The filter's posterior at a frame whose scan ends at `scan_end_s`,
 /// against `truth` (the symmetric variant nearest it when `symmetries` is
 /// not empty); [`FilterScore::NONE`] when the filter did not fuse the frame.
@@ -68,12 +49,17 @@ pub fn score(
     truth: &Pose,
     symmetries: &[Rotation3<f64>],
 ) -> FilterScore {
-    let Some((pose, cov)) = state
-        .filter(|s| s.initialized != 0 && (s.t_s - scan_end_s).abs() <= SAME_TIME_S)
-        .and_then(state_pose)
+    // The suite's one conversion of the message (a bad state scores NaN).
+    let Some(p) = state
+        .and_then(|s| prediction_from_state(s).ok().flatten())
+        .filter(|p| (p.t - scan_end_s).abs() <= SAME_TIME_S)
     else {
         return FilterScore::NONE;
     };
+    let (pose, cov) = (
+        p.pose,
+        std::array::from_fn(|i| std::array::from_fn(|j| p.covariance[(i, j)])),
+    );
     let (ang_deg, pos_m) = pose_error(&pose, truth, symmetries);
     FilterScore {
         ang_err_deg: ang_deg,
@@ -85,6 +71,7 @@ pub fn score(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Vector3;
 
     fn state(t_s: f64, q: [f64; 4], p: [f64; 3], sigma_rad: f64, sigma_m: f64) -> FilterState {
         let mut s = FilterState::new();
