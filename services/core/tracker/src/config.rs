@@ -191,7 +191,7 @@ pub const DEFAULT_RELEASE_LEVER_ARM_M: f64 = 0.045;
 pub const DEFAULT_CT_NDT_MIN_POINTS: usize = 0;
 
 /// Default [`TrackerConfig::ct_ndt_motion_prior_weight`].
-pub const DEFAULT_CT_NDT_MOTION_PRIOR_WEIGHT: f64 = 1.0;
+pub const DEFAULT_CT_NDT_MOTION_PRIOR_WEIGHT: f64 = 0.4;
 
 /// Default [`TrackerConfig::ct_ndt_attitude_covariance_scale`]: 1 with the
 /// motion prior; 30 was tuned for the free-start CT-NDT without it.

@@ -239,13 +239,12 @@ impl Dispatch<'_> {
         }
         let at_start = self.filter.predict_at(scan.start_s)?;
         let dt = scan.end_s - scan.start_s;
-        let scale = self.measurement_scale() * weight;
+        let scale = self.measurement_scale();
+        let initial = self.filter.config();
         // Δt² times the velocity covariances, in the start prior's units.
-        let information = |cov: Matrix3<f64>, s: f64| {
-            let cov = cov * (dt * dt);
-            ((cov + cov.transpose()) * 0.5)
-                .cholesky()
-                .map(|c| c.inverse() * s)
+        let information = |cov: Matrix3<f64>, initial_sigma: f64, s: f64| {
+            motion_information(cov * (dt * dt), initial_sigma * dt, s)
+                .map(|i| i * weight)
                 .ok_or(TrackError::NoStartPrior { t_s: scan.start_s })
         };
         let cov_w = at_start
@@ -259,11 +258,15 @@ impl Dispatch<'_> {
         let rate = RatePrior {
             // R^e (R^s)ᵀ of t_target_sensor: Exp(-ω Δt) in the target frame.
             turn: at_end.pose.rotation.inverse() * at_start.pose.rotation,
-            information: information(cov_w, scale * ct_attitude_scale(self.config, self.mode))?,
+            information: information(
+                cov_w,
+                initial.initial_sigma_w_degps.to_radians(),
+                scale * ct_attitude_scale(self.config, self.mode),
+            )?,
         };
         let displacement = DisplacementPrior {
             displacement_m: at_end.pose.translation - at_start.pose.translation,
-            information: information(cov_v, scale)?,
+            information: information(cov_v, initial.initial_sigma_v_mps, scale)?,
         };
         Ok(CtPriors {
             start: StartPrior {
@@ -276,9 +279,63 @@ impl Dispatch<'_> {
     }
 }
 
+/// The information of a motion prior (the filter's velocity covariance
+/// over the scan, `cov`) in the registration's units, where only what the
+/// measurements taught the filter is deflated: `I₀ + s (Σ⁻¹ − I₀)₊`, with
+/// `I₀ = σ₀⁻² I` the information of the filter's initial uncertainty over
+/// the scan (`initial_sigma`, the velocity's σ times Δt) and `(·)₊` the
+/// positive part. The filter fused the registrations' covariance times `s`,
+/// so the information they added is `s` times too small for a prior
+/// weighed against the registration's own Hessian; its initial uncertainty
+/// is an honest prior and stays as it is. Deflating that too (`s Σ⁻¹`)
+/// made the first scan's prior ω = 0 ± 3°/s instead of ± 30°/s, which
+/// pulled frame 1 of development seed 13's tumble 3.2° off
+/// (`docs/design/measurement-covariance.md`). In the steady state
+/// `I₀ ≪ Σ⁻¹` and this is `s Σ⁻¹`. `None` if `cov` is not positive definite.
+fn motion_information(cov: Matrix3<f64>, initial_sigma: f64, s: f64) -> Option<Matrix3<f64>> {
+    let cov = (cov + cov.transpose()) * 0.5;
+    let info = cov.cholesky()?.inverse();
+    let i0 = (initial_sigma * initial_sigma).recip();
+    let learned = (info - Matrix3::identity() * i0).symmetric_eigen();
+    let learned_plus = learned.eigenvectors
+        * Matrix3::from_diagonal(&learned.eigenvalues.map(|e| e.max(0.0)))
+        * learned.eigenvectors.transpose();
+    let out = Matrix3::identity() * i0 + learned_plus * s;
+    out.iter().all(|v| v.is_finite()).then_some(out)
+}
+
 #[cfg(test)]
 mod tests {
-    use super::attitude_scaling;
+    use super::{Matrix3, attitude_scaling, motion_information};
+
+    /// The initial uncertainty is not deflated, what was learned is, and
+    /// the steady state is `s Σ⁻¹`.
+    #[test]
+    fn only_what_the_measurements_taught_is_deflated() {
+        let s = 100.0;
+        let sigma0: f64 = 0.5;
+        let i0 = sigma0.powi(-2);
+        // Nothing learned: the initial information as it is.
+        let at_start = motion_information(Matrix3::identity() * sigma0.powi(2), sigma0, s).unwrap();
+        assert!((at_start - Matrix3::identity() * i0).norm() < 1e-9 * i0);
+        // Grown by process noise beyond the initial: still I₀, never less.
+        let grown =
+            motion_information(Matrix3::identity() * 4.0 * sigma0.powi(2), sigma0, s).unwrap();
+        assert!((grown - Matrix3::identity() * i0).norm() < 1e-9 * i0);
+        // Learned on one axis: that axis deflated, the others as they were.
+        let cov = Matrix3::from_diagonal(&nalgebra::Vector3::new(
+            0.01,
+            sigma0.powi(2),
+            sigma0.powi(2),
+        ));
+        let m = motion_information(cov, sigma0, s).unwrap();
+        assert!((m[(0, 0)] - (i0 + s * (100.0 - i0))).abs() < 1e-6);
+        assert!((m[(1, 1)] - i0).abs() < 1e-9 && m[(0, 1)].abs() < 1e-9);
+        // Steady state: within 1 % of s Σ⁻¹.
+        let steady = motion_information(Matrix3::identity() * 1e-6, sigma0, s).unwrap();
+        assert!((steady[(2, 2)] / (s * 1e6) - 1.0).abs() < 0.01);
+        assert!(motion_information(Matrix3::zeros(), sigma0, s).is_none());
+    }
     use nalgebra::Matrix6;
 
     /// `D C D` multiplies the attitude block by `s`, the cross blocks by
