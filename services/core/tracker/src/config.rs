@@ -109,7 +109,9 @@ pub struct TrackerConfig {
     /// this. 0 = none (the start prior of the free-start CT-NDT); large = the
     /// predicted motion, i.e. `deblur`. Not in the paper; see
     /// `spacepose_registration::{RatePrior, DisplacementPrior}` and
-    /// `docs/design/ct-ndt-motion-prior.md`.
+    /// `docs/design/ct-ndt-motion-prior.md`. Default 0.4: the weight 1
+    /// chosen before the filter fused a scaled covariance, brought to the
+    /// same steady-state firmness (`docs/design/measurement-covariance.md`).
     pub ct_ndt_motion_prior_weight: f64,
     /// In `ct-ndt` mode, a frame whose CT-NDT stalls (stops at its
     /// iteration limit still moving by more than
