@@ -3,7 +3,7 @@
 //! a deployment prefix unique to the calling test, so bus tests can run in
 //! parallel without meeting.
 
-use std::process::Child;
+use std::process::{Child, Command, ExitStatus};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 /// Owns a started service process and kills it when dropped (also when a
@@ -14,6 +14,23 @@ impl Drop for ChildGuard {
     fn drop(&mut self) {
         let _ = self.0.kill();
         let _ = self.0.wait();
+    }
+}
+
+impl ChildGuard {
+    /// Sends SIGTERM (the way a supervisor stops a service) and waits up to
+    /// `timeout` for the exit; panics if `kill` fails or the process is
+    /// still running then.
+    pub fn terminate(&mut self, timeout: Duration) -> ExitStatus {
+        let pid = self.0.id().to_string();
+        let sent = Command::new("kill").args(["-TERM", &pid]).status();
+        assert!(
+            sent.as_ref().is_ok_and(|s| s.success()),
+            "kill -TERM {pid}: {sent:?}"
+        );
+        wait_for("the exit after SIGTERM", timeout, || {
+            self.0.try_wait().ok().flatten()
+        })
     }
 }
 
@@ -64,6 +81,15 @@ mod tests {
             }),
             3
         );
+    }
+
+    #[test]
+    fn terminate_stops_the_process() {
+        let child = Command::new("sleep").arg("30").spawn().unwrap();
+        let mut guard = ChildGuard(child);
+        let status = guard.terminate(Duration::from_secs(5));
+        // `sleep` does not handle SIGTERM: it dies of it.
+        assert!(!status.success());
     }
 
     #[test]

@@ -3,31 +3,11 @@
 //! the suite's end-to-end tests (`tests/`) start.
 #![allow(clippy::unwrap_used)] // tests may unwrap
 
-use spacepose_bus::Bus;
+use spacepose_bus::{Bus, Subscriber};
 use spacepose_messages::{Health, Names, PoseEstimate, ServiceState, WireStatus};
-use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
-
-/// MCAP's magic, at the start and at the end of a closed file.
-const MAGIC: &[u8] = b"\x89MCAP0\r\n";
-
-/// Kills the service if the test fails before stopping it.
-struct Service(Child);
-
-impl Drop for Service {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-fn prefix() -> String {
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .unwrap()
-        .subsec_nanos();
-    format!("trec{}x{}", std::process::id(), nanos % 1_000_000)
-}
+use spacepose_runtime::testing::{ChildGuard, unique_prefix, wait_for};
+use std::process::{Command, Stdio};
+use std::time::Duration;
 
 fn recorder() -> Command {
     Command::new(env!("CARGO_BIN_EXE_spacepose-recorder"))
@@ -66,8 +46,8 @@ fn a_config_without_file_or_live_view_is_refused_in_one_line() {
 }
 
 #[test]
-fn a_recording_stopped_by_sigterm_is_a_closed_mcap_file() {
-    let prefix = prefix();
+fn a_recording_stopped_by_sigterm_is_a_closed_mcap_file_with_every_pose() {
+    let prefix = unique_prefix("trec");
     let names = Names::new(&prefix).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("run.mcap");
@@ -77,7 +57,7 @@ fn a_recording_stopped_by_sigterm_is_a_closed_mcap_file() {
     let bus = Bus::open(&names, "test").unwrap();
     let health = bus.subscriber::<Health>(&names.health()).unwrap();
     let poses = bus.publisher::<PoseEstimate>(&names.pose()).unwrap();
-    let mut service = Service(
+    let mut service = ChildGuard(
         recorder()
             .args(["--prefix", &prefix, "--heartbeat-ms", "50", "--config"])
             .arg(&config)
@@ -86,7 +66,9 @@ fn a_recording_stopped_by_sigterm_is_a_closed_mcap_file() {
             .spawn()
             .unwrap(),
     );
-    wait_health(&health, ServiceState::Running);
+    heartbeat(&health, "running", |h| {
+        h.state == ServiceState::Running as u8
+    });
     for seq in 1..=3u64 {
         let mut e = PoseEstimate::new();
         e.sequence = seq;
@@ -94,48 +76,26 @@ fn a_recording_stopped_by_sigterm_is_a_closed_mcap_file() {
         e.status = WireStatus::Tracking as u8;
         e.p_sensor_target = [0.0, 0.0, 12.0];
         poses.send(&e).unwrap();
-        std::thread::sleep(Duration::from_millis(50));
     }
-    std::thread::sleep(Duration::from_millis(300));
+    heartbeat(&health, "three frames in", |h| h.counters.frames_in >= 3);
 
-    let pid = service.0.id().to_string();
-    assert!(
-        Command::new("kill")
-            .args(["-TERM", &pid])
-            .status()
-            .unwrap()
-            .success()
-    );
-    let deadline = Instant::now() + Duration::from_secs(10);
-    let status = loop {
-        if let Some(s) = service.0.try_wait().unwrap() {
-            break s;
-        }
-        assert!(Instant::now() < deadline, "no exit after SIGTERM");
-        std::thread::sleep(Duration::from_millis(20));
-    };
-    assert!(status.success());
+    let status = service.terminate(Duration::from_secs(10));
+    assert!(status.success(), "{status:?}");
     let bytes = std::fs::read(&file).unwrap();
-    assert!(bytes.len() > 2 * MAGIC.len(), "{} bytes", bytes.len());
-    assert_eq!(&bytes[..MAGIC.len()], MAGIC, "no MCAP header");
-    assert_eq!(&bytes[bytes.len() - MAGIC.len()..], MAGIC, "not closed");
-    let channel = b"/spacepose/pose";
-    assert!(
-        bytes.windows(channel.len()).any(|w| w == channel),
-        "no pose channel in the file"
-    );
+    mcap::Summary::read(&bytes)
+        .unwrap()
+        .expect("closed: a summary");
+    let recorded = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .filter(|m| m.as_ref().unwrap().channel.topic == "/spacepose/pose")
+        .count();
+    assert_eq!(recorded, 3);
 }
 
-/// Waits (20 s at most) for the recorder's heartbeat in `state`.
-fn wait_health(health: &spacepose_bus::Subscriber<Health>, state: ServiceState) {
-    let deadline = Instant::now() + Duration::from_secs(20);
-    loop {
-        while let Some(h) = health.try_recv().unwrap() {
-            if h.instance.as_str() == "recorder" && h.state == state as u8 {
-                return;
-            }
-        }
-        assert!(Instant::now() < deadline, "no {state:?} heartbeat");
-        std::thread::sleep(Duration::from_millis(10));
-    }
+/// The recorder's first heartbeat that `accept`s (20 s at most).
+fn heartbeat(health: &Subscriber<Health>, what: &str, accept: impl Fn(&Health) -> bool) -> Health {
+    wait_for(what, Duration::from_secs(20), || {
+        std::iter::from_fn(|| health.try_recv().unwrap())
+            .find(|h| h.instance.as_str() == "recorder" && accept(h))
+    })
 }
