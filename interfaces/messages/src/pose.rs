@@ -62,6 +62,10 @@ pub struct PoseEstimate {
     pub status: u8,
     /// [`TrackingMode::code`] of the registration that produced the pose.
     pub mode: u8,
+    /// Rotations the surface in view left free, held at the prediction or
+    /// on the rate fitted before the hold (0-3): an extrapolation, whose
+    /// uncertainty `covariance` carries (`spacepose_tracker::HeldAxes`).
+    pub held_axes: u8,
     /// Registration iterations used.
     pub iterations: u32,
     /// Sequence of the cloud frame this pose was computed from.
@@ -122,6 +126,7 @@ impl WireMessage for PoseEstimate {
     fn validate(&self) -> Result<(), CodecError> {
         check_code("status", self.status, WireStatus::Lost as u8)?;
         check_code("mode", self.mode, TrackingMode::MAX_CODE)?;
+        check_code("held_axes", self.held_axes, 3)?;
         check_name("instance", &self.instance)
     }
 

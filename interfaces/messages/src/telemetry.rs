@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 use spacepose_geometry::Euler321;
 
 /// Version of the JSON telemetry schema (bumped on any incompatible change).
-pub const TELEMETRY_SCHEMA_VERSION: u16 = 1;
+pub const TELEMETRY_SCHEMA_VERSION: u16 = 2;
 
 /// Key suffixes below `spacepose/{prefix}/telemetry/`.
 pub mod keys {
@@ -70,6 +70,9 @@ pub struct TelemetryPose {
     pub sigma_pos_cm: [f64; 3],
     /// Final registration cost (NDT score or ICP mean squared distance, m²).
     pub cost: f64,
+    /// Rotations held by the registration, not measured (0-3): their
+    /// uncertainty is in `sigma_rot_deg`.
+    pub held_axes: u8,
     /// Registration iterations.
     pub iterations: u32,
     /// Inlier points of the registration.
@@ -104,6 +107,7 @@ impl TelemetryPose {
             sigma_rot_deg: sigmas(&m.covariance, 0, 180.0 / std::f64::consts::PI),
             sigma_pos_cm: sigmas(&m.covariance, 3, 100.0),
             cost: m.cost,
+            held_axes: m.held_axes,
             iterations: m.iterations,
             inliers: m.inliers,
             points_used: m.points_used,

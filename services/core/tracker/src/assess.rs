@@ -5,6 +5,7 @@
 
 use crate::config::{LossConfig, TrackerConfig};
 use crate::dispatch::{attitude_scaling, ct_attitude_scale};
+use crate::held_axes::HeldAxes;
 use crate::mode::TrackingMode;
 use crate::status::TrackStatus;
 use nalgebra::Matrix6;
@@ -67,6 +68,19 @@ pub(crate) fn inconsistency(
             "inconsistent with prediction ({innovation_rot_deg:.1} deg, {innovation_pos_m:.3} m; \
              limits {limit_rot_deg:.1} deg, {:.3} m)",
             l.max_innovation_pos_m
+        )
+    })
+}
+
+/// The reason to doubt a frame whose held rotation is more uncertain than
+/// `loss.max_held_sigma_deg` ([`crate::held_axes`]).
+pub(crate) fn held_doubt(l: &LossConfig, held: Option<&HeldAxes>) -> Option<String> {
+    let h = held?;
+    let sigma_deg = h.sigma_rad.to_degrees();
+    (sigma_deg > l.max_held_sigma_deg).then(|| {
+        format!(
+            "{} rotation(s) held with σ {sigma_deg:.1} deg (limit {:.1} deg)",
+            h.count, l.max_held_sigma_deg
         )
     })
 }

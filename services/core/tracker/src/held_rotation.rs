@@ -22,7 +22,8 @@
 //! axis follows the line: an extrapolation, not a measurement, which the
 //! filter then fuses like the rest of the pose.
 
-use nalgebra::{Matrix3, Matrix6, Rotation3, Vector3, Vector6};
+use crate::held_axes::{held_turn, weakest_rotations};
+use nalgebra::{Matrix6, Rotation3, Vector3};
 use serde::{Deserialize, Serialize};
 use spacepose_geometry::{Pose, so3};
 use spacepose_registration::Registration;
@@ -103,6 +104,10 @@ struct Line {
     phi_ref: f64,
     rate: f64,
     t_ref: f64,
+    /// Standard deviations of `phi_ref` (rad) and `rate` (rad/s) from the
+    /// fit's residuals (ordinary least squares).
+    sigma_phi_ref: f64,
+    sigma_rate: f64,
     /// The angle of the last pose of the chain and that pose.
     phi_last: f64,
     last: Sample,
@@ -115,6 +120,10 @@ pub struct HeldCorrection {
     pub rate_rad_s: f64,
     /// The turn applied to the result about the held axis (rad).
     pub turn_rad: f64,
+    /// Standard deviation of the line's angle at the result's time (rad):
+    /// `√(σ_ref² + σ_rate² (t − t_ref)²)`, an extrapolation's uncertainty
+    /// (`crate::held_axes` publishes it as the held rotation's).
+    pub sigma_rad: f64,
 }
 
 /// The track's recent poses and, during a hold, the line its held rotation
@@ -224,9 +233,11 @@ impl HeldRotation {
         let phi = line.phi_last + turned(&line.last.r_ts, &t_target_sensor.rotation, &line.axis);
         let turn = line.phi_ref + line.rate * (t - line.t_ref) - phi;
         *t_target_sensor = turn_about(t_target_sensor, &line.axis, turn, information);
+        let dt = t - line.t_ref;
         Some(HeldCorrection {
             rate_rad_s: line.rate,
             turn_rad: turn,
+            sigma_rad: (line.sigma_phi_ref.powi(2) + (line.sigma_rate * dt).powi(2)).sqrt(),
         })
     }
 
@@ -255,11 +266,19 @@ impl HeldRotation {
         if stt <= 0.0 {
             return None;
         }
+        let rate = stp / stt;
+        let residual2: f64 = points
+            .iter()
+            .map(|p| (p.1 - phi_ref - rate * (p.0 - t_ref)).powi(2))
+            .sum::<f64>()
+            / (n - 2.0).max(1.0);
         Some(Line {
             axis,
             phi_ref,
-            rate: stp / stt,
+            rate,
             t_ref,
+            sigma_phi_ref: (residual2 / n).sqrt(),
+            sigma_rate: (residual2 / stt).sqrt(),
             phi_last: phi,
             last: *prev,
         })
@@ -282,36 +301,36 @@ pub fn turn_about(
     turn: f64,
     information: &nalgebra::Matrix6<f64>,
 ) -> Pose {
-    let h_tt = information.fixed_view::<3, 3>(3, 3).into_owned();
-    let h_tr: Matrix3<f64> = information.fixed_view::<3, 3>(3, 0).into_owned();
-    let shift = h_tt
-        .try_inverse()
-        .map_or(Vector3::zeros(), |inv| -(inv * h_tr * axis));
-    let (r, s) = (axis * turn, shift * turn);
-    t_target_sensor.oplus(&Vector6::new(r.x, r.y, r.z, s.x, s.y, s.z))
+    t_target_sensor.oplus(&(held_turn(information, axis) * turn))
 }
 
 impl HeldRotation {
     /// A result that held one rotation, turned about it to follow the rate
-    /// fitted before the hold; any other result as it is.
-    pub fn follow(&mut self, t: f64, mut registration: Registration) -> Registration {
+    /// fitted before the hold, with the correction applied; any other
+    /// result as it is, with `None`.
+    pub fn follow(
+        &mut self,
+        t: f64,
+        mut registration: Registration,
+    ) -> (Registration, Option<HeldCorrection>) {
         if registration.degenerate_directions != 1 {
-            return registration;
+            return (registration, None);
         }
         let Some(h) = registration.geometric_information else {
-            return registration;
+            return (registration, None);
         };
-        if let Some(axis) = weakest_rotation(&h)
-            && let Some(c) = self.correct(t, &mut registration.t_target_sensor, &axis, &h)
-        {
+        let correction = weakest_rotation(&h)
+            .and_then(|axis| self.correct(t, &mut registration.t_target_sensor, &axis, &h));
+        if let Some(c) = correction {
             tracing::debug!(
                 t,
                 rate_deg_s = c.rate_rad_s.to_degrees(),
                 turn_deg = c.turn_rad.to_degrees(),
+                sigma_deg = c.sigma_rad.to_degrees(),
                 "held rotation follows the fitted rate"
             );
         }
-        registration
+        (registration, correction)
     }
 }
 
@@ -320,14 +339,7 @@ impl HeldRotation {
 /// marginalised out (the held one, as the registration's degeneracy
 /// handling finds it); `None` when `h` is not usable.
 pub(crate) fn weakest_rotation(h: &Matrix6<f64>) -> Option<Vector3<f64>> {
-    let h_rr = h.fixed_view::<3, 3>(0, 0).into_owned();
-    let h_rt = h.fixed_view::<3, 3>(0, 3).into_owned();
-    let h_tt_inv = h.fixed_view::<3, 3>(3, 3).into_owned().try_inverse()?;
-    let schur = h_rr - h_rt * h_tt_inv * h_rt.transpose();
-    let eig = ((schur + schur.transpose()) * 0.5).symmetric_eigen();
-    let i = eig.eigenvalues.imin();
-    let v = eig.eigenvectors.column(i).into_owned();
-    v.iter().all(|x| x.is_finite()).then_some(v)
+    weakest_rotations(h, 1).first().copied()
 }
 
 /// `registration` with its held rotation (one, as [`weakest_rotation`]

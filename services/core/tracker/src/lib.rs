@@ -26,6 +26,7 @@ pub mod config;
 mod depth_image;
 mod dispatch;
 pub mod error;
+pub mod held_axes;
 pub mod held_rotation;
 pub mod innovation;
 pub mod length_unit;
@@ -42,6 +43,7 @@ pub mod visibility;
 
 pub use config::{CtStart, LossConfig, TrackerConfig};
 pub use error::TrackError;
+pub use held_axes::HeldAxes;
 pub use held_rotation::{HeldCorrection, HeldRotation, HeldRotationConfig};
 pub use length_unit::{REFERENCE_LENGTH_M, map_params_scaled};
 pub use mode::TrackingMode;

@@ -50,6 +50,10 @@ pub struct LossConfig {
     pub max_final_increment_deg: f64,
     /// See [`Self::max_final_increment_deg`] (m).
     pub max_final_increment_m: f64,
+    /// Largest standard deviation of a held rotation's angle (deg) for a
+    /// frame to count as `tracking` ([`crate::held_axes`]): 1°, the 3°
+    /// tracking goal as 3σ (an angle, the same for every target).
+    pub max_held_sigma_deg: f64,
     /// Degraded frames in a row after which the track is declared lost.
     pub max_consecutive_degraded: u32,
     /// The attitude innovation limit that follows the track once its rate
@@ -70,6 +74,7 @@ impl Default for LossConfig {
             max_innovation_pos_m: 0.3,
             max_final_increment_deg: 1.0,
             max_final_increment_m: 0.05,
+            max_held_sigma_deg: 1.0,
             max_consecutive_degraded: 5,
             innovation: InnovationLimitConfig::default(),
         }
@@ -115,6 +120,7 @@ impl LossConfig {
             ("loss.max_innovation_pos_m", l.max_innovation_pos_m),
             ("loss.max_final_increment_deg", l.max_final_increment_deg),
             ("loss.max_final_increment_m", l.max_final_increment_m),
+            ("loss.max_held_sigma_deg", l.max_held_sigma_deg),
         ];
         for (name, v) in positive {
             if !(v.is_finite() && v > 0.0) {

@@ -1,5 +1,6 @@
 //! What the tracker returns for every frame.
 
+use crate::held_axes::HeldAxes;
 use crate::status::TrackStatus;
 use nalgebra::{Matrix6, Vector3};
 use spacepose_filter::Prediction;
@@ -69,6 +70,9 @@ pub struct TrackOutput {
     /// Points the visibility gate found behind the model at the prediction
     /// and dropped (`crate::visibility`): mirror ghosts of reflections.
     pub points_behind: usize,
+    /// The rotations the registration held and their uncertainty
+    /// ([`crate::held_axes`]); `None` when it held none or did not run.
+    pub held: Option<HeldAxes>,
 }
 
 impl TrackOutput {
@@ -96,6 +100,7 @@ impl TrackOutput {
             fallback: false,
             start_up: false,
             points_behind: 0,
+            held: None,
         }
     }
 
@@ -104,6 +109,11 @@ impl TrackOutput {
     /// prediction, the status `lost`, and nothing was fused.
     pub fn has_measurement(&self) -> bool {
         self.registration.is_some()
+    }
+
+    /// Rotations held by the registration (0 when none, or none ran).
+    pub fn held_axes(&self) -> usize {
+        self.held.as_ref().map_or(0, |h| h.count)
     }
 
     /// Registration iterations (0 when none ran).

@@ -46,6 +46,7 @@ pub fn fill_estimate(e: &mut PoseEstimate, out: &TrackOutput) {
         .as_ref()
         .map_or([[0.0; 6]; 6], matrix6_to_wire);
     e.iterations = saturating_u32(out.iterations());
+    e.held_axes = u8::try_from(out.held_axes().min(3)).unwrap_or(3);
     if let Some(r) = &out.registration {
         e.cost = r.cost.mean;
         e.inliers = saturating_u32(r.inliers);
@@ -120,6 +121,7 @@ mod tests {
             fallback: false,
             start_up: false,
             points_behind: 0,
+            held: None,
         };
         fill_estimate(&mut e, &out);
         assert_eq!(e.wire_status().unwrap(), WireStatus::Degraded);

@@ -18,6 +18,7 @@ fn frame(frame: usize, status: TrackStatus, ang: f64, pos_cm: f64) -> FrameRecor
         inlier_fraction: 0.9,
         degenerate_directions: 0,
         weakest_lever_arm_m: 0.1,
+        held_sigma_deg: f64::NAN,
         points_in: 1000,
         points_used: 900,
         points_behind: 0,

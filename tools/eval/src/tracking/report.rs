@@ -52,6 +52,9 @@ pub struct FrameRecord {
     pub degenerate_directions: usize,
     /// The weakest rotation's lever arm (m; NaN when not computed).
     pub weakest_lever_arm_m: f64,
+    /// Standard deviation of the held rotation (deg, `spacepose_tracker::HeldAxes`);
+    /// NaN (null) when nothing was held.
+    pub held_sigma_deg: f64,
     /// Raw points in the frame.
     pub points_in: usize,
     /// Points after pre-processing.
@@ -251,6 +254,9 @@ pub fn record(
         inlier_fraction: reg.map_or(f64::NAN, |r| r.inlier_fraction()),
         degenerate_directions: reg.map_or(0, |r| r.degenerate_directions),
         weakest_lever_arm_m: reg.map_or(f64::NAN, |r| r.weakest_lever_arm_m),
+        held_sigma_deg: out
+            .and_then(|o| o.held.as_ref())
+            .map_or(f64::NAN, |h| h.sigma_rad.to_degrees()),
         points_in: frame.points.len(),
         points_used: out.map_or(0, |o| o.points_used),
         points_behind: out.map_or(0, |o| o.points_behind),

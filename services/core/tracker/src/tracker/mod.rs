@@ -3,10 +3,11 @@
 //! the held rotation ([`crate::held_rotation`]), the assessment
 //! ([`crate::assess`]) and the filter, frame after frame.
 
-use crate::assess::{attitude_scaled, inconsistency, published, quality_issues};
+use crate::assess::{attitude_scaled, held_doubt, inconsistency, published, quality_issues};
 use crate::config::TrackerConfig;
 use crate::dispatch::{Dispatch, LastPose, ndt_params};
 use crate::error::TrackError;
+use crate::held_axes::HeldAxes;
 use crate::held_rotation::HeldRotation;
 use crate::innovation::InnovationHistory;
 use crate::measurement::{covariance_sensor_target, measurement_information};
@@ -189,10 +190,11 @@ impl Tracker {
         };
         self.holding = m.registration.degenerate_directions > 0;
         let scan_w = scan_rate(m.t_target_sensor_start.as_ref(), &m.registration, &scan);
-        let registration = self.held.follow(scan_end, m.registration);
+        let (registration, line) = self.held.follow(scan_end, m.registration);
+        let held = HeldAxes::of(&registration, line.as_ref(), &prediction);
         let counts = (points.len(), m.points_used);
         let fitted = (m.mode, m.compensated, m.start_up);
-        let mut out = self.assess(registration, fitted, &prediction, scan_end, counts)?;
+        let mut out = self.assess(registration, held, fitted, &prediction, scan_end, counts)?;
         out.fallback = m.fallback;
         out.start_up = m.mode != self.config.mode;
         out.points_behind = m.points_behind;
@@ -246,6 +248,7 @@ impl Tracker {
     fn assess(
         &mut self,
         registration: Registration,
+        held: Option<HeldAxes>,
         (mode, compensated, start_up): (TrackingMode, bool, bool),
         prediction: &Prediction,
         t: f64,
@@ -256,16 +259,21 @@ impl Tracker {
             so3::distance(&measured.rotation, &prediction.pose.rotation).to_degrees();
         let innovation_pos_m = (measured.translation - prediction.pose.translation).norm();
         let information = measurement_information(&registration, self.config.geometric_sigma_m);
-        let covariance =
-            covariance_sensor_target(&registration.t_target_sensor, &information).map(|c| {
-                attitude_scaled(&self.config, mode, c, compensated)
-                    * self.config.measurement_covariance_scale
-            });
+        let t_ts = &registration.t_target_sensor;
+        let covariance = covariance_sensor_target(t_ts, &information).map(|c| {
+            attitude_scaled(&self.config, mode, c, compensated)
+                * self.config.measurement_covariance_scale
+        });
+        let (fused, covariance) = match (&held, covariance) {
+            (Some(h), Some(c)) => (Some(h.fused(t_ts, &c)), Some(h.published(t_ts, &c))),
+            (_, c) => (c, c),
+        };
         let nis = self
             .filter
-            .innovation(t, &measured, covariance.as_ref())
+            .innovation(t, &measured, fused.as_ref())
             .map_or(f64::NAN, |o| o.mahalanobis2);
         let mut reasons = quality_issues(&self.config, &registration);
+        reasons.extend(held_doubt(&self.config.loss, held.as_ref()));
         let loss = &self.config.loss;
         let limit =
             self.innovations
@@ -277,7 +285,7 @@ impl Tracker {
             innovation_pos_m,
         ));
         if reasons.is_empty() {
-            let outcome = self.filter.update(t, &measured, covariance)?;
+            let outcome = self.filter.update(t, &measured, fused)?;
             if !outcome.fused {
                 reasons.push(format!(
                     "filter gate: Mahalanobis² {:.1}",
@@ -312,6 +320,7 @@ impl Tracker {
             fallback: false,
             start_up: false,
             points_behind: 0,
+            held,
         })
     }
 
