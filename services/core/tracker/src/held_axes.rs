@@ -29,7 +29,6 @@
 //! vouched for. The default, 1°, is the tracking goal (3°) as 3σ: an
 //! angle, so it does not depend on the target's size.
 
-use crate::held_rotation::HeldCorrection;
 use crate::measurement::inversion_jacobian;
 use nalgebra::{Matrix6, Vector3, Vector6};
 use spacepose_filter::Prediction;
@@ -58,11 +57,12 @@ pub struct HeldAxes {
 
 impl HeldAxes {
     /// The held rotations of `registration` (the result as published, at
-    /// `prediction`'s time), or `None` when it held none. `line` is the
-    /// fitted line's correction, when the hold followed one.
+    /// `prediction`'s time), or `None` when it held none. `line_sigma_rad`
+    /// is the fitted line's σ (`crate::HeldCorrection::sigma_rad`), when
+    /// the hold followed one.
     pub fn of(
         registration: &Registration,
-        line: Option<&HeldCorrection>,
+        line_sigma_rad: Option<f64>,
         prediction: &Prediction,
     ) -> Option<HeldAxes> {
         let count = registration.degenerate_directions;
@@ -75,8 +75,8 @@ impl HeldAxes {
         let axes = weakest_rotations(&h, count.min(3));
         let turns: Vec<Vector6<f64>> = axes.iter().map(|a| held_turn(&h, a)).collect();
         let t_ts = &registration.t_target_sensor;
-        let sigma_rad = match line {
-            Some(c) if count == 1 => c.sigma_rad,
+        let sigma_rad = match line_sigma_rad {
+            Some(sigma) if count == 1 => sigma,
             _ => axes
                 .iter()
                 .map(|a| predicted_sigma(t_ts, a, prediction))
@@ -85,7 +85,7 @@ impl HeldAxes {
         Some(HeldAxes {
             count,
             sigma_rad,
-            from_line: line.is_some() && count == 1,
+            from_line: line_sigma_rad.is_some() && count == 1,
             turns,
         })
     }

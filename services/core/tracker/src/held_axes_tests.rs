@@ -1,5 +1,4 @@
 use super::*;
-use crate::held_rotation::HeldCorrection;
 use nalgebra::Matrix6;
 use spacepose_registration::{Cost, Increment};
 
@@ -137,19 +136,15 @@ fn a_hold_away_from_the_prediction_adds_the_turn() {
 #[test]
 fn a_hold_on_the_fitted_line_carries_the_line_uncertainty() {
     let t_ts = turned_pose();
-    let line = HeldCorrection {
-        rate_rad_s: 0.1,
-        turn_rad: 0.01,
-        sigma_rad: 0.2f64.to_radians(),
-    };
+    let line_sigma_rad = 0.2f64.to_radians();
     let p = prediction(t_ts.inverse(), 0.5);
-    let held = HeldAxes::of(&registration(t_ts, 1, weak_z()), Some(&line), &p).unwrap();
-    assert_eq!(held.sigma_rad, line.sigma_rad);
+    let held = HeldAxes::of(&registration(t_ts, 1, weak_z()), Some(line_sigma_rad), &p).unwrap();
+    assert_eq!(held.sigma_rad, line_sigma_rad);
     // The line is independent of the filter: it is fused with its own σ.
     let axis_sensor = t_ts.rotation.inverse() * Vector3::z();
     let fused = held.fused(&t_ts, &Matrix6::zeros());
     let v = variance_about(&fused, &axis_sensor);
-    assert!((v - line.sigma_rad.powi(2)).abs() < 1e-12, "{v}");
+    assert!((v - line_sigma_rad.powi(2)).abs() < 1e-12, "{v}");
 }
 
 #[test]

@@ -191,7 +191,7 @@ impl Tracker {
         self.holding = m.registration.degenerate_directions > 0;
         let scan_w = scan_rate(m.t_target_sensor_start.as_ref(), &m.registration, &scan);
         let (registration, line) = self.held.follow(scan_end, m.registration);
-        let held = HeldAxes::of(&registration, line.as_ref(), &prediction);
+        let held = HeldAxes::of(&registration, line.map(|c| c.sigma_rad), &prediction);
         let counts = (points.len(), m.points_used);
         let fitted = (m.mode, m.compensated, m.start_up);
         let mut out = self.assess(registration, held, fitted, &prediction, scan_end, counts)?;
