@@ -75,46 +75,46 @@ impl HeldAxes {
         let axes = weakest_rotations(&h, count.min(3));
         let turns: Vec<Vector6<f64>> = axes.iter().map(|a| held_turn(&h, a)).collect();
         let t_ts = &registration.t_target_sensor;
-        let sigma_rad = match line_sigma_rad {
-            Some(sigma) if count == 1 => sigma,
-            _ => axes
-                .iter()
+        // The line follows one held rotation only.
+        let line_sigma_rad = line_sigma_rad.filter(|_| count == 1);
+        let sigma_rad = line_sigma_rad.unwrap_or_else(|| {
+            axes.iter()
                 .map(|a| predicted_sigma(t_ts, a, prediction))
-                .fold(0.0, f64::max),
-        };
+                .fold(0.0, f64::max)
+        });
         Some(HeldAxes {
             count,
             sigma_rad,
-            from_line: line_sigma_rad.is_some() && count == 1,
+            from_line: line_sigma_rad.is_some(),
             turns,
         })
     }
 
     /// `covariance` (of `t_sensor_target`, left ⊕) with the held turns'
-    /// variance added: what is published.
-    pub fn published(&self, t_target_sensor: &Pose, covariance: &Matrix6<f64>) -> Matrix6<f64> {
-        self.inflated(t_target_sensor, covariance, self.sigma_rad.powi(2))
-    }
-
-    /// `covariance` with the held turns' variance the filter may fuse: the
-    /// line's, or [`NO_INFORMATION`] times the prediction's.
-    pub fn fused(&self, t_target_sensor: &Pose, covariance: &Matrix6<f64>) -> Matrix6<f64> {
+    /// variance added, as `(fused, published)`: what the filter may fuse
+    /// (the line's variance, or [`NO_INFORMATION`] times the
+    /// prediction's), and what is published (`σ²`).
+    pub fn covariances(
+        &self,
+        t_target_sensor: &Pose,
+        covariance: &Matrix6<f64>,
+    ) -> (Matrix6<f64>, Matrix6<f64>) {
         let var = self.sigma_rad.powi(2);
-        let var = if self.from_line {
+        // A held angle the prediction knows exactly still gets no weight.
+        let fused_var = if self.from_line {
             var
         } else {
-            // A held angle the prediction knows exactly still gets no weight.
             (var * NO_INFORMATION).max(1.0)
         };
-        self.inflated(t_target_sensor, covariance, var)
-    }
-
-    fn inflated(&self, t_ts: &Pose, covariance: &Matrix6<f64>, var: f64) -> Matrix6<f64> {
-        let a = inversion_jacobian(t_ts);
-        self.turns.iter().fold(*covariance, |c, u| {
+        let a = inversion_jacobian(t_target_sensor);
+        let (mut fused, mut published) = (*covariance, *covariance);
+        for u in &self.turns {
             let xi = a * u;
-            c + xi * xi.transpose() * var
-        })
+            let outer = xi * xi.transpose();
+            fused += outer * fused_var;
+            published += outer * var;
+        }
+        (fused, published)
     }
 }
 

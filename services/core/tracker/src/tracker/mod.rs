@@ -265,7 +265,10 @@ impl Tracker {
                 * self.config.measurement_covariance_scale
         });
         let (fused, covariance) = match (&held, covariance) {
-            (Some(h), Some(c)) => (Some(h.fused(t_ts, &c)), Some(h.published(t_ts, &c))),
+            (Some(h), Some(c)) => {
+                let (fused, published) = h.covariances(t_ts, &c);
+                (Some(fused), Some(published))
+            }
             (_, c) => (c, c),
         };
         let nis = self
