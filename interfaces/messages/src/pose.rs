@@ -66,6 +66,10 @@ pub struct PoseEstimate {
     /// on the rate fitted before the hold (0-3): an extrapolation, whose
     /// uncertainty `covariance` carries (`spacepose_tracker::HeldAxes`).
     pub held_axes: u8,
+    /// Translations the surface in view hardly constrained, held at the
+    /// prediction (0-3), likewise extrapolated
+    /// (`spacepose_registration::NdtParams::min_translation_cosine`).
+    pub held_translations: u8,
     /// Registration iterations used.
     pub iterations: u32,
     /// Sequence of the cloud frame this pose was computed from.
@@ -127,6 +131,7 @@ impl WireMessage for PoseEstimate {
         check_code("status", self.status, WireStatus::Lost as u8)?;
         check_code("mode", self.mode, TrackingMode::MAX_CODE)?;
         check_code("held_axes", self.held_axes, 3)?;
+        check_code("held_translations", self.held_translations, 3)?;
         check_name("instance", &self.instance)
     }
 

@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 use spacepose_geometry::Euler321;
 
 /// Version of the JSON telemetry schema (bumped on any incompatible change).
-pub const TELEMETRY_SCHEMA_VERSION: u16 = 2;
+pub const TELEMETRY_SCHEMA_VERSION: u16 = 3;
 
 /// Key suffixes below `spacepose/{prefix}/telemetry/`.
 pub mod keys {
@@ -73,6 +73,9 @@ pub struct TelemetryPose {
     /// Rotations held by the registration, not measured (0-3): their
     /// uncertainty is in `sigma_rot_deg`.
     pub held_axes: u8,
+    /// Translations held by the registration, not measured (0-3): their
+    /// uncertainty is in `sigma_pos_cm`.
+    pub held_translations: u8,
     /// Registration iterations.
     pub iterations: u32,
     /// Inlier points of the registration.
@@ -108,6 +111,7 @@ impl TelemetryPose {
             sigma_pos_cm: sigmas(&m.covariance, 3, 100.0),
             cost: m.cost,
             held_axes: m.held_axes,
+            held_translations: m.held_translations,
             iterations: m.iterations,
             inliers: m.inliers,
             points_used: m.points_used,

@@ -33,6 +33,7 @@ pub(super) fn pose_estimate(rng: &mut impl Rng) -> PoseEstimate {
         status: rng.random_range(0..3),
         mode: rng.random_range(0..4),
         held_axes: rng.random_range(0..4),
+        held_translations: rng.random_range(0..4),
         iterations: rng.random(),
         sequence: rng.random(),
         t_s: f(rng),
@@ -241,6 +242,9 @@ fn content_is_validated_after_decoding() {
     let mut bad_held = pose_estimate(&mut rng);
     bad_held.held_axes = 4;
     assert!(matches!(encode(&bad_held), Err(CodecError::Invalid(_))));
+    let mut bad_shift = pose_estimate(&mut rng);
+    bad_shift.held_translations = 4;
+    assert!(matches!(encode(&bad_shift), Err(CodecError::Invalid(_))));
 
     // Forge a body with a bad code by encoding the raw postcard body ourselves.
     let mut body = postcard::to_allocvec(&bad_status).unwrap();

@@ -1,4 +1,5 @@
-//! NDT's degeneracy handling (`NdtParams::min_lever_arm_m`) for a
+//! NDT's degeneracy handling (`NdtParams::min_lever_arm_m`,
+//! `NdtParams::min_translation_cosine`) for a
 //! registration that has none of its own: point-to-point ICP.
 //!
 //! ICP's Hessian is that of the points, not of the surface, so it never
@@ -16,7 +17,8 @@ use crate::normal_equations::Constrained;
 use crate::params::NdtParams;
 use crate::result::Registration;
 use crate::source::position_is_finite;
-use nalgebra::{Matrix3, Vector3, Vector6};
+use crate::weak_directions::Held;
+use nalgebra::{Matrix6, Vector3};
 use spacepose_geometry::{Point, Pose};
 
 /// The well-constrained directions of the surface seen by `source` placed
@@ -28,7 +30,7 @@ pub(crate) fn constrained_directions(
     t_target_sensor: &Pose,
     params: &NdtParams,
 ) -> Option<Constrained> {
-    if params.min_lever_arm_m <= 0.0 {
+    if !params.handles_degeneracy() {
         return None;
     }
     let positions: Vec<Vector3<f64>> = source
@@ -37,27 +39,28 @@ pub(crate) fn constrained_directions(
         .map(Point::position)
         .collect();
     let (h, n) = geometric_information(map, &positions, t_target_sensor, 1, params);
-    Constrained::of(&h, n, params.min_lever_arm_m)
+    Constrained::of(&h, n, params.min_lever_arm_m, params.min_translation_cosine)
 }
 
 /// Applies NDT's degeneracy handling to `registration`, a result fitted by
-/// a method without it (ICP), holding the rotations the surface leaves
+/// a method without it (ICP), holding the directions the surface leaves
 /// free at `reference_t_target_sensor`: the registration's own guess, as
 /// [`crate::register_ndt`] holds them, or a prediction.
 ///
-/// The directions come from the surface seen from the reference pose.
-/// Each rotation whose lever arm is below `params.min_lever_arm_m` is
-/// held: its component of `registration ⊖ reference` is removed together
-/// with the translation that goes with it (the geometric information's
-/// Schur complement, `−H_tt⁻¹ H_tr a` per unit turn about `a`), which
-/// leaves the surface fitted. The result then carries
-/// `degenerate_directions`, `weakest_lever_arm_m` and
+/// The directions come from the surface seen from the reference pose
+/// ([`crate::weak_directions`]). Each rotation whose lever arm is below
+/// `params.min_lever_arm_m` is held: its component of `registration ⊖
+/// reference` is removed together with the translation that goes with it,
+/// which leaves the surface fitted. Then each translation whose cosine is
+/// below `params.min_translation_cosine` is held the same way, with the
+/// turn of the kept rotations that goes with it. The result then carries
+/// `degenerate_directions`, `held_translations`, the weakest figures and
 /// `geometric_information` as NDT's would; everything else (cost,
 /// inliers, information, iterations) is the registration's own.
 ///
 /// Returns `registration` unchanged when the handling is disabled or the
 /// surface's information is unusable.
-pub fn hold_weak_rotations(
+pub fn hold_weak_directions(
     map: &NdtMap,
     source: &[Point],
     reference_t_target_sensor: &Pose,
@@ -68,48 +71,33 @@ pub fn hold_weak_rotations(
     let Some(c) = constrained_directions(map, source, reference, params) else {
         return registration;
     };
-    let kept_rotations: Vec<Vector3<f64>> = c
-        .basis
-        .iter()
-        .filter(|b| b.fixed_rows::<3>(3).norm() == 0.0)
-        .map(|b| b.fixed_rows::<3>(0).into_owned())
-        .collect();
-    if kept_rotations.len() < 3 {
-        let h = &c.information;
-        let h_tt = h.fixed_view::<3, 3>(3, 3).into_owned();
-        let h_tr: Matrix3<f64> = h.fixed_view::<3, 3>(3, 0).into_owned();
-        let coupling = h_tt.try_inverse().map(|inv| -(inv * h_tr));
-        let mut eps = registration.t_target_sensor.ominus(reference);
-        for axis in dropped_axes(&kept_rotations) {
-            let turn = axis.dot(&eps.fixed_rows::<3>(0));
-            let shift = coupling.map_or(Vector3::zeros(), |k| k * axis);
-            eps -= Vector6::new(axis.x, axis.y, axis.z, shift.x, shift.y, shift.z) * turn;
-        }
-        registration.t_target_sensor = reference.oplus(&eps);
+    let h = &c.information;
+    let held = Held::of(h, c.held_rotations, c.held_translations);
+    if c.held_rotations + c.held_translations > 0 {
+        registration.t_target_sensor = held_at(&held, h, &registration.t_target_sensor, reference);
     }
-    registration.degenerate_directions = c.dropped();
+    registration.degenerate_directions = c.held_rotations;
+    registration.held_translations = c.held_translations;
     registration.weakest_lever_arm_m = c.weakest_lever_arm_m;
+    registration.weakest_translation_cosine = c.weakest_translation_cosine;
     registration.geometric_information = Some(c.information);
     registration
 }
 
-/// An orthonormal basis of the rotations orthogonal to `kept` (itself
-/// orthonormal, fewer than three).
-fn dropped_axes(kept: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
-    let mut dropped: Vec<Vector3<f64>> = Vec::new();
-    for e in [Vector3::x(), Vector3::y(), Vector3::z()] {
-        let mut v = e;
-        for k in kept.iter().chain(dropped.iter()) {
-            v -= k * k.dot(&v);
-        }
-        if let Some(u) = v.try_normalize(1e-6) {
-            dropped.push(u);
-        }
-        if kept.len() + dropped.len() == 3 {
-            break;
-        }
+/// `t_target_sensor` with its `held` directions moved to those of
+/// `reference`.
+fn held_at(held: &Held, h: &Matrix6<f64>, t_target_sensor: &Pose, reference: &Pose) -> Pose {
+    let mut eps = t_target_sensor.ominus(reference);
+    // Rotations first: their shifts may move a held translation, whose
+    // turns lie in the kept rotations only.
+    for (axis, turn) in held.rotations.iter().zip(held.moves(h)) {
+        eps -= turn * axis.dot(&eps.fixed_rows::<3>(0));
     }
-    dropped
+    let shifts = held.moves(h).into_iter().skip(held.rotations.len());
+    for (axis, shift) in held.translations.iter().zip(shifts) {
+        eps -= shift * axis.dot(&eps.fixed_rows::<3>(3));
+    }
+    reference.oplus(&eps)
 }
 
 #[cfg(test)]

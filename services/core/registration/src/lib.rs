@@ -27,6 +27,7 @@ pub mod result;
 mod source;
 pub mod synthetic;
 mod voxel_box;
+pub mod weak_directions;
 
 #[cfg(test)]
 mod test_support;
@@ -36,7 +37,7 @@ pub use ct_ndt::{
     ct_point_jacobian, interpolate, register_ct_ndt, register_ct_ndt_free_start,
     register_ct_ndt_with_priors,
 };
-pub use degeneracy::hold_weak_rotations;
+pub use degeneracy::hold_weak_directions;
 pub use error::RegistrationError;
 pub use icp::{IcpFarLookupStats, IcpLookupStats, IcpModel, register_icp};
 pub use ndt::register_ndt;

@@ -79,10 +79,11 @@ pub fn register_ndt(
     params.validate()?;
     check_pose("initial_t_target_sensor", initial_t_target_sensor)?;
     let (points, skipped) = finite_positions(source)?;
-    let constrained = (params.min_lever_arm_m > 0.0)
+    let constrained = params
+        .handles_degeneracy()
         .then(|| {
             let (h, n) = geometric_information(map, &points, initial_t_target_sensor, 1, params);
-            Constrained::of(&h, n, params.min_lever_arm_m)
+            Constrained::of(&h, n, params.min_lever_arm_m, params.min_translation_cosine)
         })
         .flatten();
     gauss_newton::run(

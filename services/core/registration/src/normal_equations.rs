@@ -3,6 +3,7 @@
 
 use crate::error::RegistrationError;
 use crate::result::Increment;
+use crate::weak_directions;
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 /// `Σ JᵀPJ`, `Σ JᵀPr`, `Σ rᵀPr` and `Σ |r|²` over the inliers, kept as
@@ -135,7 +136,8 @@ impl NormalEquations {
 }
 
 /// The well-constrained directions of a geometric information matrix
-/// (see `NdtParams::min_lever_arm_m`).
+/// (see `NdtParams::min_lever_arm_m` and
+/// `NdtParams::min_translation_cosine`).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Constrained {
     /// Basis of the directions kept, in `δ = [rot; trans]` coordinates.
@@ -143,53 +145,73 @@ pub(crate) struct Constrained {
     /// The weakest rotation's lever arm: `√(λ_min / N)` of the rotation
     /// block with the translation marginalised out (m).
     pub weakest_lever_arm_m: f64,
+    /// The weakest translation's RMS cosine with the normals: `√(λ_min /
+    /// N)` of the translation block with the kept rotations marginalised
+    /// out (see [`crate::weak_directions`]).
+    pub weakest_translation_cosine: f64,
+    /// Rotations left out.
+    pub held_rotations: usize,
+    /// Translations left out.
+    pub held_translations: usize,
     /// The geometric information itself (unit point noise).
     pub information: Matrix6<f64>,
 }
 
 impl Constrained {
-    /// From the geometric information `h = Σ Jᵀ n nᵀ J` of `n` points: the
-    /// rotation information with the translation marginalised out (Schur
-    /// complement `H_rr − H_rt H_tt⁻¹ H_tr`) is eigen-decomposed; a
-    /// rotation axis whose mean squared lever arm `λ / n` is below
-    /// `min_lever_arm_m²` is left out (a 1 rad turn about it moves the
-    /// points along their normals by less than that, on average). The three
-    /// translations are always kept. `None` when the translation block is
-    /// singular or `h` is not finite.
-    pub(crate) fn of(h: &Matrix6<f64>, n: usize, min_lever_arm_m: f64) -> Option<Self> {
+    /// From the geometric information `h = Σ Jᵀ n nᵀ J` of `n` points
+    /// ([`crate::weak_directions`]): a rotation axis whose mean squared
+    /// lever arm `λ / n` (translation free) is below `min_lever_arm_m²` is
+    /// left out (a 1 rad turn about it moves the points along their
+    /// normals by less than that, on average); then a translation whose
+    /// `λ / n` (kept rotations free) is below `min_translation_cosine²`
+    /// (a 1 m shift along it moves them by less than that many metres).
+    /// `None` when the translation block is singular or `h` is not finite.
+    pub(crate) fn of(
+        h: &Matrix6<f64>,
+        n: usize,
+        min_lever_arm_m: f64,
+        min_translation_cosine: f64,
+    ) -> Option<Self> {
         if n == 0 || !h.iter().all(|v| v.is_finite()) {
             return None;
         }
-        let h_rr = h.fixed_view::<3, 3>(0, 0).into_owned();
-        let h_rt = h.fixed_view::<3, 3>(0, 3).into_owned();
-        let h_tt = h.fixed_view::<3, 3>(3, 3).into_owned();
-        let h_tt_inv = h_tt.try_inverse()?;
-        let schur = h_rr - h_rt * h_tt_inv * h_rt.transpose();
-        let eig = ((schur + schur.transpose()) * 0.5).symmetric_eigen();
-        let min2 = min_lever_arm_m * min_lever_arm_m;
-        let mut basis: Vec<Vector6<f64>> = (0..3)
-            .filter(|&i| eig.eigenvalues[i] / n as f64 >= min2)
-            .map(|i| {
-                let v = eig.eigenvectors.column(i);
-                Vector6::new(v[0], v[1], v[2], 0.0, 0.0, 0.0)
-            })
-            .collect();
-        for k in 3..6 {
-            let mut e = Vector6::zeros();
-            e[k] = 1.0;
-            basis.push(e);
+        let rotations = weak_directions::rotations(h, n);
+        if rotations.len() < 3 {
+            return None;
         }
-        let weakest = eig.eigenvalues.min().max(0.0) / n as f64;
+        let min2 = min_lever_arm_m * min_lever_arm_m;
+        let held_rotations = rotations.iter().filter(|d| d.per_point < min2).count();
+        let kept: Vec<Vector3<f64>> = rotations[held_rotations..].iter().map(|d| d.axis).collect();
+        let translations = weak_directions::translations(h, n, &kept);
+        if translations.len() < 3 {
+            return None;
+        }
+        let cos2 = min_translation_cosine * min_translation_cosine;
+        let held_translations = translations.iter().filter(|d| d.per_point < cos2).count();
+        let rot = |a: &Vector3<f64>| Vector6::new(a.x, a.y, a.z, 0.0, 0.0, 0.0);
+        let trans = |a: &Vector3<f64>| Vector6::new(0.0, 0.0, 0.0, a.x, a.y, a.z);
+        let basis = kept
+            .iter()
+            .map(rot)
+            .chain(
+                translations[held_translations..]
+                    .iter()
+                    .map(|d| trans(&d.axis)),
+            )
+            .collect();
         Some(Self {
             basis,
-            weakest_lever_arm_m: weakest.sqrt(),
+            weakest_lever_arm_m: rotations[0].per_point.sqrt(),
+            weakest_translation_cosine: translations[0].per_point.sqrt(),
+            held_rotations,
+            held_translations,
             information: *h,
         })
     }
 
-    /// Directions left out.
+    /// Rotations left out.
     pub(crate) fn dropped(&self) -> usize {
-        6 - self.basis.len()
+        self.held_rotations
     }
 }
 

@@ -148,6 +148,15 @@ pub struct NdtParams {
     /// disables it (the paper).
     #[serde(default)]
     pub min_lever_arm_m: f64,
+    /// The translation half of the degeneracy handling (issue 25 item 4;
+    /// not in seed 000): with the rotations that are not held free, a
+    /// translation whose RMS cosine with the surface normals is below
+    /// this gets no increment, and keeps the initial guess along it
+    /// together with the turn that keeps the surface fitted
+    /// ([`crate::weak_directions`]). Dimensionless, so the same for every
+    /// target. 0 disables it (the paper).
+    #[serde(default)]
+    pub min_translation_cosine: f64,
 }
 
 impl Default for NdtParams {
@@ -161,11 +170,18 @@ impl Default for NdtParams {
             coarse_stride: 4,
             coarse_switch: 5.0,
             min_lever_arm_m: 0.0,
+            min_translation_cosine: 0.0,
         }
     }
 }
 
 impl NdtParams {
+    /// True when either half of the degeneracy handling is on, so the
+    /// geometric information is computed.
+    pub fn handles_degeneracy(&self) -> bool {
+        self.min_lever_arm_m > 0.0 || self.min_translation_cosine > 0.0
+    }
+
     /// Rejects NaN, infinite, non-positive or out-of-domain values.
     pub fn validate(&self) -> Result<(), RegistrationError> {
         check_positive("max_distance_m", self.max_distance_m)?;
@@ -176,6 +192,14 @@ impl NdtParams {
             return Err(RegistrationError::param(
                 "min_lever_arm_m",
                 "must be finite and >= 0",
+            ));
+        }
+        if !(self.min_translation_cosine.is_finite()
+            && (0.0..1.0).contains(&self.min_translation_cosine))
+        {
+            return Err(RegistrationError::param(
+                "min_translation_cosine",
+                "must be finite, >= 0 and < 1",
             ));
         }
         if self.max_iterations == 0 {

@@ -68,6 +68,13 @@ pub struct Registration {
     /// initial pose (m; NaN when not computed: degeneracy handling off,
     /// CT-NDT, ICP). Near 0: a rotation the surface does not constrain.
     pub weakest_lever_arm_m: f64,
+    /// Translations left at the initial guess as weakly constrained
+    /// (`NdtParams::min_translation_cosine`; 0 when off and for ICP).
+    pub held_translations: usize,
+    /// The weakest translation's RMS cosine with the surface normals, the
+    /// rotations that were not held free, at the initial pose (NaN when
+    /// not computed). Near 0: a shift the surface hardly constrains.
+    pub weakest_translation_cosine: f64,
     /// The geometric (point-to-plane) information `Σ Jᵀ n nᵀ J` at the
     /// initial pose, for a unit point noise, when the degeneracy handling
     /// computed it: what the surface in view constrains, unlike

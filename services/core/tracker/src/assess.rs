@@ -73,16 +73,32 @@ pub(crate) fn inconsistency(
 }
 
 /// The reason to doubt a frame whose held rotation is more uncertain than
-/// `loss.max_held_sigma_deg` ([`crate::held_axes`]).
+/// `loss.max_held_sigma_deg`, or whose held translation is, as an angle
+/// seen from the sensor ([`crate::held_axes`]).
 pub(crate) fn held_doubt(l: &LossConfig, held: Option<&HeldAxes>) -> Option<String> {
     let h = held?;
     let sigma_deg = h.sigma_rad.to_degrees();
-    (sigma_deg > l.max_held_sigma_deg).then(|| {
-        format!(
-            "{} rotation(s) held with σ {sigma_deg:.1} deg (limit {:.1} deg)",
-            h.count, l.max_held_sigma_deg
-        )
-    })
+    let bearing_deg = if h.translations > 0 {
+        h.sigma_bearing_rad().to_degrees()
+    } else {
+        0.0
+    };
+    let limit = l.max_held_sigma_deg;
+    let mut parts = Vec::new();
+    if sigma_deg > limit {
+        parts.push(format!(
+            "{} rotation(s) held with σ {sigma_deg:.1} deg (limit {limit:.1} deg)",
+            h.count
+        ));
+    }
+    if bearing_deg > limit {
+        parts.push(format!(
+            "{} translation(s) held with σ {:.2} m, {bearing_deg:.1} deg seen from the sensor \
+             (limit {limit:.1} deg)",
+            h.translations, h.sigma_m
+        ));
+    }
+    (!parts.is_empty()).then(|| parts.join("; "))
 }
 
 /// The measurement covariance `[rot; trans]` with its attitude inflated by

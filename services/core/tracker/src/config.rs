@@ -45,7 +45,7 @@ pub struct TrackerConfig {
     pub ndt_mode_min_lever_arm_m: f64,
     /// `ndt.min_lever_arm_m` in `icp` mode (m): ICP's Hessian is that of
     /// the points, so the rotations the surface leaves free are found from
-    /// the NDT map's normals ([`spacepose_registration::hold_weak_rotations`])
+    /// the NDT map's normals ([`spacepose_registration::hold_weak_directions`])
     /// and held at the filter's prediction (then moved onto the fitted
     /// rate, as in the other modes). From the previous pose, nearest
     /// neighbours drag the roll from a lever arm of about 5.4 cm (slow-spin,
@@ -216,6 +216,16 @@ pub const DEFAULT_ICP_MODE_MIN_LEVER_ARM_M: f64 = 0.055;
 /// [`TrackerConfig::ndt`].
 pub const DEFAULT_MIN_LEVER_ARM_M: f64 = 0.035;
 
+/// Default `ndt.min_translation_cosine` of the tracker: 0, off. Holding a
+/// weak translation at the prediction was measured and does not pay with
+/// this filter: at 1.2 % it cut the frames published `tracking` more than
+/// 50 cm off on `zoo:1003`'s slow spin from 12-14 to 2, but the held
+/// shift's σ (the prediction's, mostly its attitude σ times the range)
+/// doubted every held frame, and `zoo:1004` (1.3 m across, whose cosine
+/// is 0.7 % on every frame at 15 m) was lost from frame 5; development
+/// designs, seed 2023. See `docs/design/held-translations.md`.
+pub const DEFAULT_MIN_TRANSLATION_COSINE: f64 = 0.0;
+
 /// Default of [`TrackerConfig::start_up_blur_deg`] (deg).
 pub const DEFAULT_START_UP_BLUR_DEG: f64 = 1.0;
 
@@ -226,6 +236,7 @@ impl Default for TrackerConfig {
             voxel_leaf_m: 0.02,
             ndt: NdtParams {
                 min_lever_arm_m: DEFAULT_MIN_LEVER_ARM_M,
+                min_translation_cosine: DEFAULT_MIN_TRANSLATION_COSINE,
                 ..NdtParams::default()
             },
             release_lever_arm_m: DEFAULT_RELEASE_LEVER_ARM_M,

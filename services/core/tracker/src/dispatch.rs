@@ -12,7 +12,7 @@ use spacepose_filter::{Prediction, RelativeMotionFilter};
 use spacepose_geometry::{Point, Pose};
 use spacepose_registration::{
     CtPriors, DisplacementPrior, NdtParams, RatePrior, Registration, ScanTimes, StartPrior,
-    hold_weak_rotations, register_ct_ndt, register_ct_ndt_with_priors, register_icp, register_ndt,
+    hold_weak_directions, register_ct_ndt, register_ct_ndt_with_priors, register_icp, register_ndt,
 };
 
 /// The last pose the tracker produced.
@@ -126,7 +126,7 @@ impl Dispatch<'_> {
             // seed 7: from frame 1320 at 4.5 m, 1°/s, lost).
             TrackingMode::Icp => {
                 let r = register_icp(self.model.icp()?, cloud, &previous, &c.icp)?;
-                hold_weak_rotations(map, cloud, &predicted, r, ndt).into()
+                hold_weak_directions(map, cloud, &predicted, r, ndt).into()
             }
             TrackingMode::Deblur => register_ndt(map, cloud, &predicted, ndt)?.into(),
             // A sparse frame, compensated by the prediction: one pose.

@@ -34,29 +34,39 @@ use nalgebra::{Matrix6, Vector3, Vector6};
 use spacepose_filter::Prediction;
 use spacepose_geometry::{Pose, so3};
 use spacepose_registration::Registration;
+use spacepose_registration::weak_directions::Held;
 
-/// The factor on a held rotation's variance in what the filter fuses when
+/// The factor on a held direction's variance in what the filter fuses when
 /// that variance is the prediction's own: large enough that the fused
-/// measurement adds nothing about the held angle.
+/// measurement adds nothing about the held angle or shift.
 pub const NO_INFORMATION: f64 = 1e4;
 
-/// The rotations a registration held and how uncertain they are.
+/// The rotations and translations a registration held and how uncertain
+/// they are.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HeldAxes {
     /// Rotations held (the registration's `degenerate_directions`).
     pub count: usize,
+    /// Translations held (the registration's `held_translations`).
+    pub translations: usize,
     /// Standard deviation of the held angle (rad); the largest over the
-    /// held axes.
+    /// held axes, 0 when no rotation is held.
     pub sigma_rad: f64,
+    /// Standard deviation of the held shift (m); the largest over the held
+    /// translations, 0 when none is held.
+    pub sigma_m: f64,
+    /// The sensor's distance to the target origin (m), which turns
+    /// `sigma_m` into an angle seen from the sensor.
+    pub range_m: f64,
     /// The held turns `u` (`δ = [rot; trans]` of `t_target_sensor`, per
-    /// radian about each held axis).
-    turns: Vec<Vector6<f64>>,
+    /// radian about each held axis), then the held shifts (per metre).
+    moves: Vec<Vector6<f64>>,
     /// `sigma_rad` is the fitted line's (independent of the filter).
     from_line: bool,
 }
 
 impl HeldAxes {
-    /// The held rotations of `registration` (the result as published, at
+    /// The held directions of `registration` (the result as published, at
     /// `prediction`'s time), or `None` when it held none. `line_sigma_rad`
     /// is the fitted line's σ (`crate::HeldCorrection::sigma_rad`), when
     /// the hold followed one.
@@ -65,32 +75,59 @@ impl HeldAxes {
         line_sigma_rad: Option<f64>,
         prediction: &Prediction,
     ) -> Option<HeldAxes> {
-        let count = registration.degenerate_directions;
-        if count == 0 {
+        let (count, translations) = (
+            registration.degenerate_directions.min(3),
+            registration.held_translations.min(3),
+        );
+        if count + translations == 0 {
             return None;
         }
         let h = registration
             .geometric_information
             .unwrap_or(registration.information);
-        let axes = weakest_rotations(&h, count.min(3));
-        let turns: Vec<Vector6<f64>> = axes.iter().map(|a| held_turn(&h, a)).collect();
+        let held = Held::of(&h, count, translations);
         let t_ts = &registration.t_target_sensor;
         // The line follows one held rotation only.
         let line_sigma_rad = line_sigma_rad.filter(|_| count == 1);
         let sigma_rad = line_sigma_rad.unwrap_or_else(|| {
-            axes.iter()
+            held.rotations
+                .iter()
                 .map(|a| predicted_sigma(t_ts, a, prediction))
                 .fold(0.0, f64::max)
         });
+        let sigma_m = held
+            .translations
+            .iter()
+            .map(|d| predicted_shift_sigma(t_ts, d, prediction))
+            .fold(0.0, f64::max);
         Some(HeldAxes {
-            count,
+            count: held.rotations.len(),
+            translations: held.translations.len(),
             sigma_rad,
+            sigma_m,
+            range_m: t_ts.translation.norm(),
             from_line: line_sigma_rad.is_some(),
-            turns,
+            moves: held.moves(&h),
         })
     }
 
-    /// `covariance` (of `t_sensor_target`, left ⊕) with the held turns'
+    /// The held moves (`δ = [rot; trans]` of `t_target_sensor`): each held
+    /// rotation's turn per radian, then each held translation's shift per
+    /// metre.
+    pub fn moves(&self) -> &[Vector6<f64>] {
+        &self.moves
+    }
+
+    /// `sigma_m` as an angle seen from the sensor (rad).
+    pub fn sigma_bearing_rad(&self) -> f64 {
+        if self.range_m > 0.0 {
+            (self.sigma_m / self.range_m).atan()
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// `covariance` (of `t_sensor_target`, left ⊕) with the held moves'
     /// variance added, as `(fused, published)`: what the filter may fuse
     /// (the line's variance, or [`NO_INFORMATION`] times the
     /// prediction's), and what is published (`σ²`).
@@ -99,16 +136,23 @@ impl HeldAxes {
         t_target_sensor: &Pose,
         covariance: &Matrix6<f64>,
     ) -> (Matrix6<f64>, Matrix6<f64>) {
-        let var = self.sigma_rad.powi(2);
+        let nothing = |var: f64| (var * NO_INFORMATION).max(1.0);
+        let rot_var = self.sigma_rad.powi(2);
         // A held angle the prediction knows exactly still gets no weight.
-        let fused_var = if self.from_line {
-            var
+        let rot_fused = if self.from_line {
+            rot_var
         } else {
-            (var * NO_INFORMATION).max(1.0)
+            nothing(rot_var)
         };
+        let shift_var = self.sigma_m.powi(2);
         let a = inversion_jacobian(t_target_sensor);
         let (mut fused, mut published) = (*covariance, *covariance);
-        for u in &self.turns {
+        for (i, u) in self.moves.iter().enumerate() {
+            let (var, fused_var) = if i < self.count {
+                (rot_var, rot_fused)
+            } else {
+                (shift_var, nothing(shift_var))
+            };
             let xi = a * u;
             let outer = xi * xi.transpose();
             fused += outer * fused_var;
@@ -118,36 +162,34 @@ impl HeldAxes {
     }
 }
 
-/// The `k` rotation axes (target frame, unit) the information `h`
-/// (`δ = [rot; trans]`) constrains least once the translation is
-/// marginalised out, weakest first; fewer when `h` is not usable.
-pub(crate) fn weakest_rotations(h: &Matrix6<f64>, k: usize) -> Vec<Vector3<f64>> {
-    let h_rr = h.fixed_view::<3, 3>(0, 0).into_owned();
-    let h_rt = h.fixed_view::<3, 3>(0, 3).into_owned();
-    let Some(h_tt_inv) = h.fixed_view::<3, 3>(3, 3).into_owned().try_inverse() else {
-        return Vec::new();
-    };
-    let schur = h_rr - h_rt * h_tt_inv * h_rt.transpose();
-    let eig = ((schur + schur.transpose()) * 0.5).symmetric_eigen();
-    let mut order = [0usize, 1, 2];
-    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
-    order
-        .iter()
-        .take(k)
-        .map(|&i| eig.eigenvectors.column(i).into_owned())
-        .filter(|v: &Vector3<f64>| v.iter().all(|x| x.is_finite()))
-        .collect()
-}
-
-/// The turn about `axis` with the translation that keeps the surface
-/// fitted (`−H_tt⁻¹ H_tr a`, the Schur complement's), per radian.
-pub(crate) fn held_turn(h: &Matrix6<f64>, axis: &Vector3<f64>) -> Vector6<f64> {
-    let h_tt = h.fixed_view::<3, 3>(3, 3).into_owned();
-    let h_tr = h.fixed_view::<3, 3>(3, 0).into_owned();
-    let shift = h_tt
+/// `σ` (m) of the shift along `axis` (target frame, the translation of
+/// `t_target_sensor`'s `δ`) of a result held at the prediction: the
+/// prediction's standard deviation along it and the shift from the
+/// prediction along it, in quadrature.
+///
+/// The marginal variance, which at 15 m is mostly the attitude's
+/// uncertainty times the range (the `δ` translation is the sensor's
+/// position in the target frame). The variance conditional on the other
+/// coordinates (`1 / (eᵀ Λ e)`) was tried: it is centimetres, so held
+/// frames stayed `tracking` while the filter, dragged by the frames just
+/// above the threshold, carried the hold 88 cm off (`zoo:1003` slow-spin,
+/// development seed 2023: 19-22 frames far off published `tracking`
+/// instead of 2). See `docs/design/held-translations.md`.
+fn predicted_shift_sigma(
+    t_target_sensor: &Pose,
+    axis: &Vector3<f64>,
+    prediction: &Prediction,
+) -> f64 {
+    let predicted = prediction.pose.inverse();
+    let e = Vector6::new(0.0, 0.0, 0.0, axis.x, axis.y, axis.z);
+    // δ = A⁻¹ ξ: the prediction's covariance in the `δ` of t_target_sensor.
+    let var = inversion_jacobian(&predicted)
         .try_inverse()
-        .map_or(Vector3::zeros(), |inv| -(inv * h_tr * axis));
-    Vector6::new(axis.x, axis.y, axis.z, shift.x, shift.y, shift.z)
+        .map_or(f64::INFINITY, |b| {
+            (e.transpose() * b * prediction.covariance * b.transpose() * e)[(0, 0)].max(0.0)
+        });
+    let shift = axis.dot(&t_target_sensor.ominus(&predicted).fixed_rows::<3>(3));
+    (var + shift * shift).sqrt()
 }
 
 /// `σ` (rad) of the angle about `axis` (target frame) of a result held at

@@ -22,8 +22,34 @@ fn registration(t_ts: Pose, held: usize, h: Matrix6<f64>) -> Registration {
         last_increment: Increment::default(),
         degenerate_directions: held,
         weakest_lever_arm_m: 0.01,
+        held_translations: 0,
+        weakest_translation_cosine: 0.5,
         geometric_information: Some(h),
     }
+}
+
+/// A registration at `t_ts` that held one translation, with geometric
+/// information `h`.
+fn shifted(t_ts: Pose, h: Matrix6<f64>) -> Registration {
+    Registration {
+        held_translations: 1,
+        weakest_translation_cosine: 0.01,
+        ..registration(t_ts, 0, h)
+    }
+}
+
+/// Information that hardly constrains the shift along the target's x.
+fn weak_x_shift() -> Matrix6<f64> {
+    let mut h = Matrix6::identity() * 1e6;
+    h[(3, 3)] = 1e-3;
+    h
+}
+
+/// Variance of the position along `axis_sensor` in a `t_sensor_target`
+/// covariance.
+fn variance_along(cov: &Matrix6<f64>, axis_sensor: &Vector3<f64>) -> f64 {
+    let p = cov.fixed_view::<3, 3>(3, 3).into_owned();
+    (axis_sensor.transpose() * p * axis_sensor)[(0, 0)]
 }
 
 /// A prediction at `pose` with attitude variance `var_rad2` on every axis.
@@ -64,19 +90,6 @@ fn turned_pose() -> Pose {
 fn variance_about(cov: &Matrix6<f64>, axis_sensor: &Vector3<f64>) -> f64 {
     let p = cov.fixed_view::<3, 3>(0, 0).into_owned();
     (axis_sensor.transpose() * p * axis_sensor)[(0, 0)]
-}
-
-#[test]
-fn the_weakest_rotations_come_first() {
-    let mut h = weak_z();
-    h[(0, 0)] = 1e3;
-    let axes = weakest_rotations(&h, 2);
-    assert_eq!(axes.len(), 2);
-    assert!((axes[0].z.abs() - 1.0).abs() < 1e-9, "{:?}", axes[0]);
-    assert!((axes[1].x.abs() - 1.0).abs() < 1e-9, "{:?}", axes[1]);
-    let mut singular = Matrix6::identity();
-    singular[(4, 4)] = 0.0;
-    assert!(weakest_rotations(&singular, 1).is_empty());
 }
 
 #[test]
@@ -148,19 +161,6 @@ fn a_hold_on_the_fitted_line_carries_the_line_uncertainty() {
 }
 
 #[test]
-fn the_turn_keeps_the_surface_fitted() {
-    // A rotation about z that the surface ties to a shift along x.
-    let mut h = weak_z();
-    h[(3, 2)] = 50.0;
-    h[(2, 3)] = 50.0;
-    let u = held_turn(&h, &Vector3::z());
-    // H u has no translation component: the turn costs no translation fit.
-    let hu = h * u;
-    assert!(hu.fixed_rows::<3>(3).norm() < 1e-9, "{hu:?}");
-    assert!((u[3] + 50.0 / 1e6).abs() < 1e-12);
-}
-
-#[test]
 fn the_held_doubt_follows_the_limit() {
     let l = crate::LossConfig::default();
     let mut held = HeldAxes::of(
@@ -174,4 +174,52 @@ fn the_held_doubt_follows_the_limit() {
     let reason = crate::assess::held_doubt(&l, Some(&held)).unwrap();
     assert!(reason.contains("held"), "{reason}");
     assert!(crate::assess::held_doubt(&l, None).is_none());
+}
+
+#[test]
+fn a_held_shift_at_the_prediction_is_as_uncertain_as_the_prediction() {
+    let t_ts = turned_pose();
+    // Attitude exactly known, position σ 1 cm.
+    let p = prediction(t_ts.inverse(), 0.0);
+    let held = HeldAxes::of(&shifted(t_ts, weak_x_shift()), None, &p).unwrap();
+    assert_eq!((held.count, held.translations), (0, 1));
+    assert!((held.sigma_m - 0.01).abs() < 1e-9, "{}", held.sigma_m);
+    assert_eq!(held.sigma_rad, 0.0);
+    let along = t_ts.rotation.inverse() * Vector3::x();
+    let base = Matrix6::identity() * 1e-6;
+    let (fused, published) = held.covariances(&t_ts, &base);
+    let added = variance_along(&published, &along) - 1e-6;
+    assert!((added - 1e-4).abs() < 1e-12, "{added}");
+    let across = t_ts.rotation.inverse() * Vector3::y();
+    assert!((variance_along(&published, &across) - 1e-6).abs() < 1e-15);
+    assert!(variance_along(&fused, &along) >= 1.0);
+}
+
+#[test]
+fn a_held_shift_away_from_the_prediction_adds_the_shift() {
+    let t_ts = turned_pose();
+    let predicted = Pose::new(t_ts.rotation, t_ts.translation - Vector3::x() * 0.3);
+    let p = prediction(predicted.inverse(), 0.0);
+    let held = HeldAxes::of(&shifted(t_ts, weak_x_shift()), None, &p).unwrap();
+    let expected = (1e-4f64 + 0.09).sqrt();
+    assert!((held.sigma_m - expected).abs() < 1e-9, "{}", held.sigma_m);
+}
+
+#[test]
+fn the_held_shift_doubt_is_an_angle_seen_from_the_sensor() {
+    let l = crate::LossConfig::default();
+    let t_ts = turned_pose();
+    let mut held = HeldAxes::of(
+        &shifted(t_ts, weak_x_shift()),
+        None,
+        &prediction(t_ts.inverse(), 0.0),
+    )
+    .unwrap();
+    assert!(crate::assess::held_doubt(&l, Some(&held)).is_none());
+    let limit_m = held.range_m * l.max_held_sigma_deg.to_radians().tan();
+    held.sigma_m = limit_m * 1.01;
+    let reason = crate::assess::held_doubt(&l, Some(&held)).unwrap();
+    assert!(reason.contains("translation"), "{reason}");
+    held.sigma_m = limit_m * 0.99;
+    assert!(crate::assess::held_doubt(&l, Some(&held)).is_none());
 }

@@ -22,11 +22,11 @@
 //! axis follows the line: an extrapolation, not a measurement, which the
 //! filter then fuses like the rest of the pose.
 
-use crate::held_axes::{held_turn, weakest_rotations};
 use nalgebra::{Matrix6, Rotation3, Vector3};
 use serde::{Deserialize, Serialize};
 use spacepose_geometry::{Pose, so3};
 use spacepose_registration::Registration;
+use spacepose_registration::weak_directions::{rotation_turn, rotations};
 use std::collections::VecDeque;
 
 /// Tuning of [`HeldRotation`].
@@ -301,7 +301,7 @@ pub fn turn_about(
     turn: f64,
     information: &nalgebra::Matrix6<f64>,
 ) -> Pose {
-    t_target_sensor.oplus(&(held_turn(information, axis) * turn))
+    t_target_sensor.oplus(&(rotation_turn(information, axis) * turn))
 }
 
 impl HeldRotation {
@@ -339,7 +339,7 @@ impl HeldRotation {
 /// marginalised out (the held one, as the registration's degeneracy
 /// handling finds it); `None` when `h` is not usable.
 pub(crate) fn weakest_rotation(h: &Matrix6<f64>) -> Option<Vector3<f64>> {
-    weakest_rotations(h, 1).first().copied()
+    rotations(h, 1).first().map(|d| d.axis)
 }
 
 /// `registration` with its held rotation (one, as [`weakest_rotation`]

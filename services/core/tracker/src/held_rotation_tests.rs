@@ -183,6 +183,8 @@ mod held_at_tests {
             last_increment: Increment::default(),
             degenerate_directions: held,
             weakest_lever_arm_m: 0.01,
+            held_translations: 0,
+            weakest_translation_cosine: 0.5,
             geometric_information: Some(h),
         }
     }

@@ -121,6 +121,8 @@ mod tests {
             last_increment: spacepose_registration::Increment::default(),
             degenerate_directions: 1,
             weakest_lever_arm_m: 0.0,
+            held_translations: 0,
+            weakest_translation_cosine: 0.5,
             geometric_information: geometric,
         }
     }

@@ -116,6 +116,11 @@ impl TrackOutput {
         self.held.as_ref().map_or(0, |h| h.count)
     }
 
+    /// Translations held by the registration (0 when none, or none ran).
+    pub fn held_translations(&self) -> usize {
+        self.held.as_ref().map_or(0, |h| h.translations)
+    }
+
     /// Registration iterations (0 when none ran).
     pub fn iterations(&self) -> usize {
         self.registration.as_ref().map_or(0, |r| r.iterations)

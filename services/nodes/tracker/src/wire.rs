@@ -47,6 +47,7 @@ pub fn fill_estimate(e: &mut PoseEstimate, out: &TrackOutput) {
         .map_or([[0.0; 6]; 6], matrix6_to_wire);
     e.iterations = saturating_u32(out.iterations());
     e.held_axes = u8::try_from(out.held_axes().min(3)).unwrap_or(3);
+    e.held_translations = u8::try_from(out.held_translations().min(3)).unwrap_or(3);
     if let Some(r) = &out.registration {
         e.cost = r.cost.mean;
         e.inliers = saturating_u32(r.inliers);

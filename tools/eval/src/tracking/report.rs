@@ -55,6 +55,14 @@ pub struct FrameRecord {
     /// Standard deviation of the held rotation (deg, `spacepose_tracker::HeldAxes`);
     /// NaN (null) when nothing was held.
     pub held_sigma_deg: f64,
+    /// Translations left at the prediction as weakly constrained.
+    pub held_translations: usize,
+    /// The weakest translation's RMS cosine with the surface normals
+    /// (`spacepose_registration::weak_directions`; NaN when not computed).
+    pub weakest_translation_cosine: f64,
+    /// Standard deviation of the held translation (cm); NaN (null) when
+    /// none was held.
+    pub held_sigma_cm: f64,
     /// Raw points in the frame.
     pub points_in: usize,
     /// Points after pre-processing.
@@ -256,7 +264,14 @@ pub fn record(
         weakest_lever_arm_m: reg.map_or(f64::NAN, |r| r.weakest_lever_arm_m),
         held_sigma_deg: out
             .and_then(|o| o.held.as_ref())
+            .filter(|h| h.count > 0)
             .map_or(f64::NAN, |h| h.sigma_rad.to_degrees()),
+        held_translations: reg.map_or(0, |r| r.held_translations),
+        weakest_translation_cosine: reg.map_or(f64::NAN, |r| r.weakest_translation_cosine),
+        held_sigma_cm: out
+            .and_then(|o| o.held.as_ref())
+            .filter(|h| h.translations > 0)
+            .map_or(f64::NAN, |h| h.sigma_m * 100.0),
         points_in: frame.points.len(),
         points_used: out.map_or(0, |o| o.points_used),
         points_behind: out.map_or(0, |o| o.points_behind),

@@ -154,6 +154,8 @@ fn icp_loop(
         last_increment: last,
         degenerate_directions: 0,
         weakest_lever_arm_m: f64::NAN,
+        held_translations: 0,
+        weakest_translation_cosine: f64::NAN,
         geometric_information: None,
     })
 }

@@ -63,7 +63,7 @@ fn the_roll_about_the_cylinder_is_the_one_unconstrained_rotation() {
     let params = NdtParams::default();
     let (h, n) = geometric_information(&map, &sensor_points, &t_target_sensor, 1, &params);
     assert!(n > 1000, "{n}");
-    let c = Constrained::of(&h, n, 0.035).unwrap();
+    let c = Constrained::of(&h, n, 0.035, 0.0).unwrap();
     assert_eq!(c.dropped(), 1, "{c:?}");
     assert!(c.weakest_lever_arm_m < 0.01, "{}", c.weakest_lever_arm_m);
     // The kept rotations are orthogonal to the body x axis (the roll).
@@ -72,10 +72,45 @@ fn the_roll_about_the_cylinder_is_the_one_unconstrained_rotation() {
         assert!(rot.dot(&Vector3::x()).abs() < 1e-3, "{v:?}");
     }
     // Nothing is dropped below a 1 mm lever arm.
-    assert_eq!(Constrained::of(&h, n, 0.001).unwrap().dropped(), 0);
+    assert_eq!(Constrained::of(&h, n, 0.001, 0.0).unwrap().dropped(), 0);
     // A non-finite matrix or no point: no basis.
-    assert!(Constrained::of(&(h * f64::NAN), n, 0.035).is_none());
-    assert!(Constrained::of(&h, 0, 0.035).is_none());
+    assert!(Constrained::of(&(h * f64::NAN), n, 0.035, 0.0).is_none());
+    assert!(Constrained::of(&h, 0, 0.035, 0.0).is_none());
+    // Just above the weakest translation's cosine, that shift is left out
+    // too, and the kept translations are orthogonal to it.
+    let cosine = c.weakest_translation_cosine;
+    let both = Constrained::of(&h, n, 0.035, cosine * 1.01).unwrap();
+    // The cylinder's two radial shifts are alike: both may fall below.
+    let kept: Vec<Vector3<f64>> = c
+        .basis
+        .iter()
+        .take(2)
+        .map(|v| Vector3::new(v[0], v[1], v[2]))
+        .collect();
+    let weak = crate::weak_directions::translations(&h, n, &kept);
+    let k = weak
+        .iter()
+        .filter(|d| d.per_point.sqrt() < cosine * 1.01)
+        .count();
+    assert!(k >= 1);
+    assert_eq!(
+        (both.dropped(), both.held_translations, both.basis.len()),
+        (1, k, 5 - k)
+    );
+    for held in crate::weak_directions::Held::of(&h, 1, k).translations {
+        for v in &both.basis {
+            assert!(
+                held.dot(&Vector3::new(v[3], v[4], v[5])).abs() < 1e-9,
+                "{v:?}"
+            );
+        }
+    }
+    assert_eq!(
+        Constrained::of(&h, n, 0.035, cosine * 0.99)
+            .unwrap()
+            .held_translations,
+        0
+    );
 }
 
 #[test]

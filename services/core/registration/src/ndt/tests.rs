@@ -48,6 +48,7 @@ const TIGHT: NdtParams = NdtParams {
     coarse_stride: 4,
     coarse_switch: 5.0,
     min_lever_arm_m: 0.0,
+    min_translation_cosine: 0.0,
 };
 
 /// Registers the static frame from seeded random offsets of the truth;
