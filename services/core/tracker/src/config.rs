@@ -216,14 +216,9 @@ pub const DEFAULT_ICP_MODE_MIN_LEVER_ARM_M: f64 = 0.055;
 /// [`TrackerConfig::ndt`].
 pub const DEFAULT_MIN_LEVER_ARM_M: f64 = 0.035;
 
-/// Default `ndt.min_translation_cosine` of the tracker: 0, off. Holding a
-/// weak translation at the prediction was measured and does not pay with
-/// this filter: at 1.2 % it cut the frames published `tracking` more than
-/// 50 cm off on `zoo:1003`'s slow spin from 12-14 to 2, but the held
-/// shift's σ (the prediction's, mostly its attitude σ times the range)
-/// doubted every held frame, and `zoo:1004` (1.3 m across, whose cosine
-/// is 0.7 % on every frame at 15 m) was lost from frame 5; development
-/// designs, seed 2023. See `docs/design/held-translations.md`.
+/// Default `ndt.min_translation_cosine` of the tracker: 0, off. The hold
+/// was measured on the zoo and does not pay with this filter (a 1.3 m
+/// target at 15 m is lost at frame 5): `docs/design/held-translations.md`.
 pub const DEFAULT_MIN_TRANSLATION_COSINE: f64 = 0.0;
 
 /// Default of [`TrackerConfig::start_up_blur_deg`] (deg).
