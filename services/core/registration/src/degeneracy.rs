@@ -72,12 +72,12 @@ pub fn hold_weak_directions(
         return registration;
     };
     let h = &c.information;
-    let held = Held::of(h, c.held_rotations, c.held_translations);
-    if c.held_rotations + c.held_translations > 0 {
-        registration.t_target_sensor = held_at(&held, h, &registration.t_target_sensor, reference);
+    if c.dropped() + c.held_translations() > 0 {
+        registration.t_target_sensor =
+            held_at(&c.held, h, &registration.t_target_sensor, reference);
     }
-    registration.degenerate_directions = c.held_rotations;
-    registration.held_translations = c.held_translations;
+    registration.degenerate_directions = c.dropped();
+    registration.held_translations = c.held_translations();
     registration.weakest_lever_arm_m = c.weakest_lever_arm_m;
     registration.weakest_translation_cosine = c.weakest_translation_cosine;
     registration.geometric_information = Some(c.information);
@@ -88,12 +88,13 @@ pub fn hold_weak_directions(
 /// `reference`.
 fn held_at(held: &Held, h: &Matrix6<f64>, t_target_sensor: &Pose, reference: &Pose) -> Pose {
     let mut eps = t_target_sensor.ominus(reference);
+    let moves = held.moves(h);
+    let (turns, shifts) = moves.split_at(held.rotations.len());
     // Rotations first: their shifts may move a held translation, whose
     // turns lie in the kept rotations only.
-    for (axis, turn) in held.rotations.iter().zip(held.moves(h)) {
+    for (axis, turn) in held.rotations.iter().zip(turns) {
         eps -= turn * axis.dot(&eps.fixed_rows::<3>(0));
     }
-    let shifts = held.moves(h).into_iter().skip(held.rotations.len());
     for (axis, shift) in held.translations.iter().zip(shifts) {
         eps -= shift * axis.dot(&eps.fixed_rows::<3>(3));
     }

@@ -60,7 +60,7 @@ pub(crate) fn run(
         last_increment: run.last,
         degenerate_directions: constrained.map_or(0, Constrained::dropped),
         weakest_lever_arm_m: constrained.map_or(f64::NAN, |c| c.weakest_lever_arm_m),
-        held_translations: constrained.map_or(0, |c| c.held_translations),
+        held_translations: constrained.map_or(0, Constrained::held_translations),
         weakest_translation_cosine: constrained.map_or(f64::NAN, |c| c.weakest_translation_cosine),
         geometric_information: constrained.map(|c| c.information),
     })

@@ -3,7 +3,7 @@
 
 use crate::error::RegistrationError;
 use crate::result::Increment;
-use crate::weak_directions;
+use crate::weak_directions::{self, Held, WeakDirection};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 /// `Σ JᵀPJ`, `Σ JᵀPr`, `Σ rᵀPr` and `Σ |r|²` over the inliers, kept as
@@ -149,10 +149,9 @@ pub(crate) struct Constrained {
     /// N)` of the translation block with the kept rotations marginalised
     /// out (see [`crate::weak_directions`]).
     pub weakest_translation_cosine: f64,
-    /// Rotations left out.
-    pub held_rotations: usize,
-    /// Translations left out.
-    pub held_translations: usize,
+    /// The directions left out: rotation axes, the rotations kept, and
+    /// translation axes (weakest first).
+    pub held: Held,
     /// The geometric information itself (unit point noise).
     pub information: Matrix6<f64>,
 }
@@ -181,7 +180,8 @@ impl Constrained {
         }
         let min2 = min_lever_arm_m * min_lever_arm_m;
         let held_rotations = rotations.iter().filter(|d| d.per_point < min2).count();
-        let kept: Vec<Vector3<f64>> = rotations[held_rotations..].iter().map(|d| d.axis).collect();
+        let axes = |d: &[WeakDirection]| d.iter().map(|d| d.axis).collect::<Vec<_>>();
+        let kept = axes(&rotations[held_rotations..]);
         let translations = weak_directions::translations(h, n, &kept);
         if translations.len() < 3 {
             return None;
@@ -190,7 +190,7 @@ impl Constrained {
         let held_translations = translations.iter().filter(|d| d.per_point < cos2).count();
         let rot = |a: &Vector3<f64>| Vector6::new(a.x, a.y, a.z, 0.0, 0.0, 0.0);
         let trans = |a: &Vector3<f64>| Vector6::new(0.0, 0.0, 0.0, a.x, a.y, a.z);
-        let basis = kept
+        let basis: Vec<Vector6<f64>> = kept
             .iter()
             .map(rot)
             .chain(
@@ -203,15 +203,23 @@ impl Constrained {
             basis,
             weakest_lever_arm_m: rotations[0].per_point.sqrt(),
             weakest_translation_cosine: translations[0].per_point.sqrt(),
-            held_rotations,
-            held_translations,
+            held: Held {
+                rotations: axes(&rotations[..held_rotations]),
+                kept_rotations: kept,
+                translations: axes(&translations[..held_translations]),
+            },
             information: *h,
         })
     }
 
     /// Rotations left out.
     pub(crate) fn dropped(&self) -> usize {
-        self.held_rotations
+        self.held.rotations.len()
+    }
+
+    /// Translations left out.
+    pub(crate) fn held_translations(&self) -> usize {
+        self.held.translations.len()
     }
 }
 

@@ -178,7 +178,9 @@ pub fn register_ct_ndt_with_priors(
         weakest_lever_arm_m: constrained
             .as_ref()
             .map_or(f64::NAN, |c| c.weakest_lever_arm_m),
-        held_translations: constrained.as_ref().map_or(0, |c| c.held_translations),
+        held_translations: constrained
+            .as_ref()
+            .map_or(0, Constrained::held_translations),
         weakest_translation_cosine: constrained
             .as_ref()
             .map_or(f64::NAN, |c| c.weakest_translation_cosine),

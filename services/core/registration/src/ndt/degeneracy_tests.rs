@@ -94,7 +94,7 @@ fn the_roll_about_the_cylinder_is_the_one_unconstrained_rotation() {
         .count();
     assert!(k >= 1);
     assert_eq!(
-        (both.dropped(), both.held_translations, both.basis.len()),
+        (both.dropped(), both.held_translations(), both.basis.len()),
         (1, k, 5 - k)
     );
     for held in crate::weak_directions::Held::of(&h, 1, k).translations {
@@ -108,7 +108,7 @@ fn the_roll_about_the_cylinder_is_the_one_unconstrained_rotation() {
     assert_eq!(
         Constrained::of(&h, n, 0.035, cosine * 0.99)
             .unwrap()
-            .held_translations,
+            .held_translations(),
         0
     );
 }
