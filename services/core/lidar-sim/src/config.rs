@@ -15,6 +15,10 @@ pub const MAX_RAYS_PER_FRAME: usize = 50_000_000;
 /// in the `ellipse` scenario smeared the solar array's tip by up to 0.7 m.
 pub const RASTER_SCAN_TIME_S: f64 = 0.05;
 
+/// The range extent of a 5 ns pulse, `c τ / 2` (m): echoes farther apart
+/// are resolved (`SensorConfig::echo_separation_m`).
+pub const DEFAULT_ECHO_SEPARATION_M: f64 = 0.75;
+
 /// Which effects the simulator applies; each can be switched independently.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Effects {
@@ -116,8 +120,15 @@ pub struct SensorConfig {
     pub outlier_sigma_factor: f64,
     /// β, beam divergence half-angle at 1/e² intensity (deg, seed 004 Eq. 18).
     pub beam_divergence_deg: f64,
-    /// Number of divergent rays per beam (5 in seed 004).
+    /// Number of divergent rays per beam (5 in seed 004; at most
+    /// [`crate::MAX_RAYS_PER_BEAM`]).
     pub divergent_rays: usize,
+    /// Echoes of one beam farther apart in depth than this (m) come back as
+    /// separate pulses, and the strongest is reported; closer ones merge
+    /// into their intensity-weighted average (seed 004 §IV.A averages them
+    /// all: `f64::INFINITY`). Default 0.75 m, the range extent of a 5 ns
+    /// pulse (`docs/design/echo-separation.md`).
+    pub echo_separation_m: f64,
     /// Maximum range (m): farther surfaces give no echo.
     pub max_range_m: f64,
     /// Detection model parameters (seed 002 Table 1).
@@ -169,6 +180,7 @@ impl SensorConfig {
             outlier_sigma_factor: 4.0,
             beam_divergence_deg: 0.28,
             divergent_rays: 5,
+            echo_separation_m: DEFAULT_ECHO_SEPARATION_M,
             max_range_m: 260.0,
             detection: DetectionParams::livox_mid40(),
             surface_model: SurfaceModel::Phong,
@@ -202,6 +214,7 @@ impl SensorConfig {
             outlier_sigma_factor: 4.0,
             beam_divergence_deg: 0.02,
             divergent_rays: 5,
+            echo_separation_m: DEFAULT_ECHO_SEPARATION_M,
             max_range_m: 1000.0,
             detection: DetectionParams::seed002(),
             surface_model: SurfaceModel::Lambertian,
@@ -252,11 +265,18 @@ impl SensorConfig {
                 reason: "must be in [0, 1]",
             });
         }
-        if self.divergent_rays == 0 {
+        if self.divergent_rays == 0 || self.divergent_rays > crate::MAX_RAYS_PER_BEAM {
             return Err(SimError::InvalidConfig {
                 field: "divergent_rays",
-                value: 0.0,
-                reason: "must be >= 1",
+                value: self.divergent_rays as f64,
+                reason: "must be in [1, MAX_RAYS_PER_BEAM = 16]",
+            });
+        }
+        if self.echo_separation_m.is_nan() || self.echo_separation_m <= 0.0 {
+            return Err(SimError::InvalidConfig {
+                field: "echo_separation_m",
+                value: self.echo_separation_m,
+                reason: "must be > 0 (infinite: seed 004's average of every echo)",
             });
         }
         let rays = self

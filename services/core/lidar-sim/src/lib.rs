@@ -20,6 +20,7 @@
 pub mod clutter;
 pub mod config;
 pub mod detection;
+mod echoes;
 pub mod error;
 pub mod frame;
 mod measurement;
@@ -33,6 +34,7 @@ pub mod surface;
 pub use clutter::Facility;
 pub use config::{Effects, RASTER_SCAN_TIME_S, SensorConfig, SurfaceModel};
 pub use detection::{DetectionModel, DetectionParams};
+pub use echoes::MAX_RAYS_PER_BEAM;
 pub use error::SimError;
 pub use frame::{Frame, ReturnKind};
 pub use pattern::{Scan, ScanPattern, ScanRays};

@@ -2,6 +2,7 @@
 //! velocity during the scan, the optional facility background, and the
 //! tracing of one beam (divergent rays, direct and reflected echoes).
 
+use crate::echoes::{BeamEchoes, Echo};
 use crate::optics::{Cone, cos_pow, divergence_weight, mirror, phong_backscatter, sample_cone};
 use crate::surface::Surface;
 use nalgebra::{Rotation3, Vector3};
@@ -74,6 +75,43 @@ pub(crate) struct BeamEcho {
     pub clutter: bool,
 }
 
+/// The echoes of one ray: (depth, return factor) of the direct echo and
+/// of the reflected one, if any, and whether the first surface is clutter.
+#[derive(Debug, Clone, Copy)]
+struct RayEchoes {
+    direct: (f64, f64),
+    reflected: Option<(f64, f64)>,
+    clutter: bool,
+}
+
+impl RayEchoes {
+    /// Adds this ray's echoes, weighted by its divergence `weight`, to the
+    /// beam's. With an infinite separation the ray's two echoes are merged
+    /// first, as seed 004 merges them (one echo per ray, arithmetic
+    /// unchanged), else each is kept for the receiver to separate.
+    fn add_to(&self, beam: &mut BeamEchoes, weight: f64, separation_m: f64) {
+        let (r1, direct) = self.direct;
+        let echo = |depth: f64, energy: f64| Echo {
+            depth,
+            energy: weight * energy,
+            clutter: self.clutter,
+        };
+        match self.reflected {
+            None => beam.push(echo(r1, direct)),
+            Some((path, reflected)) if separation_m.is_infinite() => {
+                let total = direct + reflected;
+                if total > 0.0 {
+                    beam.push(echo((direct * r1 + reflected * path) / total, total));
+                }
+            }
+            Some((path, reflected)) => {
+                beam.push(echo(r1, direct));
+                beam.push(echo(path, reflected));
+            }
+        }
+    }
+}
+
 /// Everything fixed during one frame.
 pub(crate) struct FrameScene<'a> {
     pub target: &'a Target,
@@ -91,6 +129,10 @@ pub(crate) struct FrameScene<'a> {
     pub rays_per_beam: usize,
     pub reflections: bool,
     pub max_range: f64,
+    /// Echoes farther apart than this are separate returns, and the
+    /// strongest is reported (`crate::echoes`); infinite: seed 004's
+    /// average of all of them.
+    pub echo_separation_m: f64,
     /// Offset of a reflected ray's origin along the surface normal (m), so it
     /// does not hit the face it leaves (`spacepose-model` advises ~1e-4 of
     /// the mesh size for its `f32` BVH).
@@ -113,8 +155,8 @@ impl FrameScene<'_> {
             },
             p,
         };
-        let (mut sum_w, mut sum_wi, mut sum_wid) = (0.0, 0.0, 0.0);
-        let (mut strongest, mut clutter) = (0.0, false);
+        let mut sum_w = 0.0;
+        let mut echoes = BeamEchoes::default();
         let cone = Cone::new(dir);
         for _ in 0..self.rays_per_beam {
             let (ray, weight) = if self.beta > 0.0 {
@@ -125,22 +167,15 @@ impl FrameScene<'_> {
                 (*dir, 1.0)
             };
             sum_w += weight;
-            if let Some((depth, intensity, is_clutter)) =
-                self.trace_ray(&snap, target_possible, &ray, rng)
-            {
-                let wi = weight * intensity;
-                sum_wi += wi;
-                sum_wid += wi * depth;
-                if wi > strongest {
-                    strongest = wi;
-                    clutter = is_clutter;
-                }
+            if let Some(ray_echoes) = self.trace_ray(&snap, target_possible, &ray, rng) {
+                ray_echoes.add_to(&mut echoes, weight, self.echo_separation_m);
             }
         }
-        (sum_wi > 0.0).then(|| BeamEcho {
-            depth: sum_wid / sum_wi,
-            intensity: sum_wi / sum_w,
-            clutter,
+        let detected = echoes.detect(self.echo_separation_m)?;
+        Some(BeamEcho {
+            depth: detected.depth,
+            intensity: detected.energy / sum_w,
+            clutter: detected.clutter,
         })
     }
 
@@ -160,14 +195,14 @@ impl FrameScene<'_> {
     }
 
     /// One ray: direct echo, plus one reflected echo in the reflection cone
-    /// (seed 004 §IV.A). Returns (depth, intensity, clutter?).
+    /// (seed 004 §IV.A).
     fn trace_ray(
         &self,
         snap: &Snapshot,
         target_possible: bool,
         dir: &Vector3<f64>,
         rng: &mut ChaCha8Rng,
-    ) -> Option<(f64, f64, bool)> {
+    ) -> Option<RayEchoes> {
         let hit = self.cast_scene(
             snap,
             target_possible,
@@ -180,16 +215,21 @@ impl FrameScene<'_> {
         // Eq. (17) with α = 2θ, times ρ_T.
         let cos1 = -dir.dot(&hit.normal);
         let direct = s.reflectance * phong_backscatter(s.kd, s.eta, cos1) / (r1 * r1);
+        let only_direct = RayEchoes {
+            direct: (r1, direct),
+            reflected: None,
+            clutter: hit.clutter,
+        };
         if !self.reflections || s.cone_half_angle <= 0.0 {
-            return Some((r1, direct, hit.clutter));
+            return Some(only_direct);
         }
         let (refl, alpha) = sample_cone(&mirror(dir, &hit.normal), s.cone_half_angle, rng);
         if refl.dot(&hit.normal) <= 0.0 {
-            return Some((r1, direct, hit.clutter));
+            return Some(only_direct);
         }
         let origin = dir * r1 + hit.normal * self.reflection_offset_m;
         let Some(hit2) = self.cast_scene(snap, true, &origin, &refl, self.max_range - r1) else {
-            return Some((r1, direct, hit.clutter));
+            return Some(only_direct);
         };
         // Specular lobe of Eq. (17) at the first surface, crossed twice (out
         // and back along the same path), back-scatter at the second one.
@@ -199,11 +239,10 @@ impl FrameScene<'_> {
         let path = r1 + hit2.distance;
         let reflected =
             lobe * lobe * s2.reflectance * phong_backscatter(s2.kd, s2.eta, cos2) / (path * path);
-        let total = direct + reflected;
-        if total <= 0.0 {
-            return None;
-        }
-        Some(((direct * r1 + reflected * path) / total, total, hit.clutter))
+        Some(RayEchoes {
+            reflected: Some((path, reflected)),
+            ..only_direct
+        })
     }
 
     /// Nearest hit of the ray `origin + s dir` (sensor frame) with the target

@@ -161,6 +161,7 @@ impl LidarSimulator {
             },
             reflections: fx.reflections,
             max_range: c.max_range_m,
+            echo_separation_m: c.echo_separation_m,
             reflection_offset_m: 1e-4 * self.target.bounding_radius() + 1e-6,
         }
     }

@@ -193,7 +193,9 @@ fn sparse_ct_ndt_frames_fit_one_compensated_pose() {
 /// with Eq. (12). On the first frame of a tumble (same filter state) it
 /// lands within 0.1° of `deblur`, where the free-start CT-NDT differs by
 /// degrees; after that the two filters fuse different information (CT's
-/// end-pose Hessian against NDT's) and drift apart a little during warm-up.
+/// end-pose Hessian against NDT's) and drift apart a little during warm-up
+/// (up to 1.10° at frame 1 on these frames since the sensor separates
+/// echoes; under 1° when it averaged them all).
 #[test]
 fn a_firm_motion_prior_makes_ct_ndt_follow_deblur() {
     // Both from the first frame as the paper runs them (no start-up).
@@ -228,7 +230,7 @@ fn a_firm_motion_prior_makes_ct_ndt_follow_deblur() {
     assert!(first_free > 1.0, "free start, frame 0: {first_free:.3} deg");
     for (k, (d, f)) in res[0].iter().zip(&res[1]).enumerate() {
         assert!(
-            gap(&f.3, &d.3) < 1.0,
+            gap(&f.3, &d.3) < 1.5,
             "frame {k}: {:.3} deg",
             gap(&f.3, &d.3)
         );

@@ -39,6 +39,10 @@ pub struct LidarSimConfig {
     pub rate_hz: f64,
     /// Test-facility background (floor, back wall, robot arm).
     pub clutter: bool,
+    /// Echoes of one beam farther apart than this (m) are separate returns
+    /// and the strongest is reported; `inf` averages them all, as seed 004
+    /// does (`SensorConfig::echo_separation_m`).
+    pub echo_separation_m: f64,
     /// Publish an acquisition result from the truth for the first frame.
     pub truth_init: bool,
     /// After the last frame (frames > 0): exit, or stay up sending heartbeats.
@@ -72,6 +76,7 @@ impl Default for LidarSimConfig {
             integration_time_s: SensorConfig::MID40_INTEGRATION_TIME_S,
             rate_hz: 1.0,
             clutter: true,
+            echo_separation_m: spacepose_lidar_sim::config::DEFAULT_ECHO_SEPARATION_M,
             truth_init: false,
             exit_at_end: false,
             sensor_id: 0,
@@ -95,6 +100,12 @@ impl ServiceConfig for LidarSimConfig {
         positive("range_m", self.range_m)?;
         positive("integration_time_s", self.integration_time_s)?;
         positive("checkpoint_max_age_s", self.checkpoint_max_age_s)?;
+        if self.echo_separation_m.is_nan() || self.echo_separation_m <= 0.0 {
+            return Err(format!(
+                "echo_separation_m must be > 0 (inf: seed 004's average), got {}",
+                self.echo_separation_m
+            ));
+        }
         if let Some(look) = &self.look_away {
             look.validate().map_err(|e| e.to_string())?;
         }
@@ -143,6 +154,7 @@ impl LidarSimConfig {
         let mut sensor = SensorConfig::livox_mid40();
         sensor.integration_time_s = self.integration_time_s;
         sensor.effects.clutter = self.clutter;
+        sensor.echo_separation_m = self.echo_separation_m;
         FrameSource::new(Arc::new(target), scenario, sensor, self.seed).context("invalid sensor")
     }
 
