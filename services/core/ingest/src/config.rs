@@ -44,6 +44,73 @@ impl AxisBox {
     }
 }
 
+/// Finding the target in a frame without a prediction
+/// ([`crate::detect`]), so that a facility's floor and walls are cropped
+/// before the first acquisition.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DetectConfig {
+    /// Detect the target when there is no prediction (otherwise the static
+    /// box or the range gate alone).
+    pub enabled: bool,
+    /// Distance from a plane within which a point lies on it (m): a sensor
+    /// length (2.5 σ of the Mid-40's 2 cm range noise), not the target's.
+    pub plane_tolerance_m: f64,
+    /// Planes searched for background patches.
+    pub max_planes: usize,
+    /// Random triples tried per plane.
+    pub ransac_iterations: usize,
+    /// The plane search runs on about this many points of the frame.
+    pub sample_points: usize,
+    /// A plane with fewer of the sampled points than this fraction ends
+    /// the search.
+    pub min_plane_fraction: f64,
+    /// The region about the detected centre has radius this times the
+    /// bounding radius, plus the margin: the centre is that of the returns,
+    /// which come from the near side only.
+    pub crop_radius_factor: f64,
+}
+
+impl Default for DetectConfig {
+    fn default() -> Self {
+        DetectConfig {
+            enabled: true,
+            plane_tolerance_m: 0.05,
+            max_planes: 4,
+            ransac_iterations: 200,
+            sample_points: 4096,
+            min_plane_fraction: 0.05,
+            crop_radius_factor: 1.5,
+        }
+    }
+}
+
+impl DetectConfig {
+    fn validate(&self) -> Result<(), IngestError> {
+        positive("detect.plane_tolerance_m", self.plane_tolerance_m)?;
+        if self.sample_points < 3 {
+            return Err(invalid(
+                "detect.sample_points",
+                self.sample_points as f64,
+                "must be >= 3",
+            ));
+        }
+        let f = self.min_plane_fraction;
+        if !(f.is_finite() && (0.0..=1.0).contains(&f)) {
+            return Err(invalid("detect.min_plane_fraction", f, "must be in [0, 1]"));
+        }
+        let c = self.crop_radius_factor;
+        if !(c.is_finite() && c >= 1.0) {
+            return Err(invalid(
+                "detect.crop_radius_factor",
+                c,
+                "must be finite and >= 1",
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Parameters of the ingest stage.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -80,6 +147,8 @@ pub struct IngestConfig {
     /// it removes what touches the target (the robot arm) but lies outside
     /// its shape. `None` keeps the sphere alone.
     pub body_box: Option<AxisBox>,
+    /// Finding the target without a prediction ([`DetectConfig`]).
+    pub detect: DetectConfig,
 }
 
 impl Default for IngestConfig {
@@ -97,6 +166,7 @@ impl Default for IngestConfig {
             min_target_points: 20,
             static_box: None,
             body_box: Some(AxisBox::deos()),
+            detect: DetectConfig::default(),
         }
     }
 }
@@ -128,7 +198,7 @@ impl IngestConfig {
         if let Some(b) = &self.body_box {
             check_box("body_box.min_m", "body_box.max_m", b)?;
         }
-        Ok(())
+        self.detect.validate()
     }
 }
 

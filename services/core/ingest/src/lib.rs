@@ -37,13 +37,17 @@
 //! A library only: the `spacepose-ingest` binary wires it to the bus.
 #![forbid(unsafe_code)]
 
+pub mod background;
 pub mod config;
+pub mod detect;
 pub mod error;
 pub mod roi;
 pub mod stage;
 pub mod stats;
 
-pub use config::{AxisBox, DEFAULT_MAX_POINTS, IngestConfig};
+pub use background::BackgroundPlane;
+pub use config::{AxisBox, DEFAULT_MAX_POINTS, DetectConfig, IngestConfig};
+pub use detect::{Detection, detect};
 pub use error::IngestError;
 pub use roi::{AttitudePrediction, PredictionIssue, Roi, RoiKind, TargetPrediction};
 pub use stage::{CropCounts, FrameReport, IngestStage, crop_into};

@@ -123,6 +123,7 @@ impl IngestStage {
             });
         }
         let (roi, issue) = Roi::for_frame(&self.config, prediction, scan_start_s, scan_end_s);
+        let roi = roi.detect_in(points, &self.config);
         let crop = crop_into(&roi, points, out);
         // An empty frame (n = 0) is not "all non-finite": it goes through.
         if n > 0 && crop.non_finite == n {
@@ -138,6 +139,7 @@ impl IngestStage {
         s.cropped_points += crop.outside as u64;
         s.ignored_predictions += u64::from(issue.is_some());
         s.frames_without_prediction += u64::from(roi.centre().is_none());
+        s.frames_detected += u64::from(roi.detection().is_some());
         s.frames_empty_after_crop += u64::from(out.is_empty());
         Ok(FrameReport {
             input_points: n,

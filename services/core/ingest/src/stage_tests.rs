@@ -126,8 +126,18 @@ fn the_crop_keeps_every_point_inside_in_time_order() {
             0.002 * k as f64 + 0.001,
         ));
     }
-    let mut s = stage();
+    // A 10 m line: without a prediction the detection would keep the part
+    // of it a target could fill; the range gate alone keeps it all.
+    let mut s = IngestStage::new(IngestConfig {
+        detect: crate::DetectConfig {
+            enabled: false,
+            ..Default::default()
+        },
+        ..IngestConfig::default()
+    })
+    .unwrap();
     let (out, report) = s.process(&pts, 0.0, 1.0, None).unwrap();
+    assert_eq!(report.roi, RoiKind::RangeOnly);
     assert_eq!(report.output_points, 1000);
     assert_eq!(out, pts);
 }
@@ -148,9 +158,11 @@ fn a_prediction_crops_to_the_sphere_and_a_wrong_one_empties_the_frame() {
     let (_, r) = s.process(&pts, 0.0, 1.0, Some(&pred)).unwrap();
     assert_eq!(r.roi, RoiKind::Predicted);
     assert_eq!((r.output_points, r.cropped_points), (1000, 2));
+    // Without a prediction, the target found in the frame: the far point
+    // is out of its sphere too.
     let (_, r) = s.process(&pts, 0.0, 1.0, None).unwrap();
-    assert_eq!(r.roi, RoiKind::RangeOnly);
-    assert_eq!((r.output_points, r.cropped_points), (1001, 1));
+    assert_eq!(r.roi, RoiKind::Detected);
+    assert_eq!((r.output_points, r.cropped_points), (1000, 2));
     let far = TargetPrediction {
         p_sensor_target: Vector3::new(0.0, 0.0, 30.0),
         ..pred
@@ -159,6 +171,7 @@ fn a_prediction_crops_to_the_sphere_and_a_wrong_one_empties_the_frame() {
     assert!(out.is_empty() && r.output_points == 0);
     assert_eq!(s.stats().frames_empty_after_crop, 1);
     assert_eq!(s.stats().frames_without_prediction, 1);
+    assert_eq!(s.stats().frames_detected, 1);
 }
 
 #[test]

@@ -30,6 +30,9 @@ pub struct IngestStats {
     pub cropped_points: u64,
     /// Accepted frames cropped without a trusted prediction.
     pub frames_without_prediction: u64,
+    /// Of those, frames cropped to the target found in them
+    /// ([`crate::detect`]).
+    pub frames_detected: u64,
     /// Predictions ignored because stale or non-finite.
     pub ignored_predictions: u64,
     /// Accepted frames with no point left in the region of interest (empty

@@ -4,7 +4,7 @@
 //! unless the file sets them.
 
 use serde::Deserialize;
-use spacepose_ingest::{AxisBox, IngestConfig};
+use spacepose_ingest::{AxisBox, DetectConfig, IngestConfig};
 use spacepose_runtime::ServiceConfig;
 
 /// `spacepose-ingest --config FILE`.
@@ -38,6 +38,9 @@ pub struct IngestServiceConfig {
     pub body_box: Option<AxisBox>,
     /// `false` crops with the sphere alone (no body box).
     pub use_body_box: bool,
+    /// Finding the target in a frame without a prediction (the `[detect]`
+    /// table: `spacepose_ingest::DetectConfig`).
+    pub detect: DetectConfig,
 }
 
 impl Default for IngestServiceConfig {
@@ -57,6 +60,7 @@ impl Default for IngestServiceConfig {
             static_box: c.static_box,
             body_box: None,
             use_body_box: true,
+            detect: c.detect,
         }
     }
 }
@@ -74,6 +78,7 @@ impl IngestServiceConfig {
             min_target_points: self.min_target_points,
             static_box: self.static_box,
             body_box: body_box.filter(|_| self.use_body_box),
+            detect: self.detect.clone(),
         }
     }
 
