@@ -70,6 +70,10 @@ pub struct TrackOutput {
     /// Points the visibility gate found behind the model at the prediction
     /// and dropped (`crate::visibility`): mirror ghosts of reflections.
     pub points_behind: usize,
+    /// The frame was registered again on the cloud gated at the first fit
+    /// ([`crate::VisibilityConfig::refit`]); `points_behind` then adds the
+    /// second gate's count.
+    pub refit: bool,
     /// The rotations the registration held and their uncertainty
     /// ([`crate::held_axes`]); `None` when it held none or did not run.
     pub held: Option<HeldAxes>,
@@ -100,6 +104,7 @@ impl TrackOutput {
             fallback: false,
             start_up: false,
             points_behind: 0,
+            refit: false,
             held: None,
         }
     }

@@ -58,6 +58,26 @@ pub struct VisibilityConfig {
     /// drops none: the prediction, not the frame, is then likely wrong, and
     /// the registration must see everything. Default 0.5.
     pub max_dropped_fraction: f64,
+    /// In the start-up (the filter's rate still unknown:
+    /// `TrackerConfig::start_up_blur_deg`), gate the cloud again at the
+    /// fitted pose after the registration, and register again on what it
+    /// keeps when that drops `refit_min_fraction` of the cloud the gate at
+    /// the prediction kept: a prediction a scan's
+    /// turn off, with its wide neighbourhood, keeps ghosts that a fit a
+    /// degree off sees (`docs/design/echo-separation.md`). Not after the
+    /// start-up: there the prediction is as good as a fit, and a second
+    /// registration only moved the pose by its noise. Default on.
+    pub refit: bool,
+    /// See `refit`. Default 0.01: a hundredth of the cloud.
+    pub refit_min_fraction: f64,
+    /// Also drop the points outside the model's bounding box (body frame)
+    /// grown by the neighbourhood's margin and `tolerance_m`: no surface
+    /// return lies there at the prediction. At a prediction as wide as the
+    /// start-up's the box grows past the target and removes nothing; at
+    /// the fit of a start-up frame (`refit`) it removes what holds the
+    /// target (a facility's robot arm), which the crop's sphere keeps until
+    /// the attitude is known. Default on.
+    pub outside_box: bool,
 }
 
 impl Default for VisibilityConfig {
@@ -67,6 +87,9 @@ impl Default for VisibilityConfig {
             tolerance_m: 0.15,
             pose_allowance_deg: 1.0,
             max_dropped_fraction: 0.5,
+            refit: true,
+            refit_min_fraction: 0.01,
+            outside_box: true,
         }
     }
 }
@@ -78,13 +101,14 @@ impl VisibilityConfig {
             && self.tolerance_m >= 0.0
             && self.pose_allowance_deg.is_finite()
             && (0.0..90.0).contains(&self.pose_allowance_deg)
-            && (0.0..=1.0).contains(&self.max_dropped_fraction);
+            && (0.0..=1.0).contains(&self.max_dropped_fraction)
+            && (0.0..=1.0).contains(&self.refit_min_fraction);
         if ok {
             Ok(())
         } else {
             Err(TrackError::InvalidConfig(format!(
                 "visibility: tolerance_m >= 0, pose_allowance_deg in [0, 90), \
-                 max_dropped_fraction in [0, 1] and all finite: {self:?}"
+                 max_dropped_fraction and refit_min_fraction in [0, 1], all finite: {self:?}"
             )))
         }
     }
@@ -95,10 +119,43 @@ impl VisibilityConfig {
 pub struct Gated {
     /// The points kept (all of them when the gate did not apply).
     pub points: Vec<Point>,
-    /// Points found behind the model (dropped unless `overruled`).
+    /// Points found behind the model, or outside its box with
+    /// `outside_box` (dropped unless `overruled`).
     pub behind: usize,
     /// More than `max_dropped_fraction` were behind, so none was dropped.
     pub overruled: bool,
+}
+
+/// Whether a point can be a surface return at the prediction.
+struct SurfaceTest {
+    image: DepthImage,
+    compensation: Option<MotionCompensation>,
+    tolerance_m: f32,
+    t_target_sensor: spacepose_geometry::Pose,
+    grown_box: Option<(Vector3<f64>, Vector3<f64>)>,
+}
+
+impl SurfaceTest {
+    /// False when the point, carried to the scan end, lies behind the
+    /// farthest first surface near its ray or outside the grown box; a
+    /// non-finite point is left to the registration, which skips it.
+    fn may_be_surface(&self, p: &Point) -> bool {
+        let x = p.position();
+        let x = self
+            .compensation
+            .as_ref()
+            .map_or(x, |c| c.position_at_end(&x, p.t));
+        if !x.iter().all(|c| c.is_finite()) {
+            return true;
+        }
+        if let Some((lo, hi)) = &self.grown_box {
+            let b = self.t_target_sensor.transform(&x);
+            if (0..3).any(|i| b[i] < lo[i] || b[i] > hi[i]) {
+                return false;
+            }
+        }
+        (x.norm() as f32) <= self.image.farthest_first_surface(&x) + self.tolerance_m
+    }
 }
 
 /// The model cloud the gate renders: the tracker's model cloud thinned to
@@ -110,6 +167,8 @@ pub struct VisibilityModel {
     points_target: Vec<Vector3<f64>>,
     spacing_m: f64,
     radius_m: f64,
+    /// The model's bounding box in the body frame.
+    bounds: (Vector3<f64>, Vector3<f64>),
 }
 
 impl VisibilityModel {
@@ -127,10 +186,18 @@ impl VisibilityModel {
             .map(|p| p.norm())
             .filter(|r| r.is_finite())
             .fold(0.0, f64::max);
+        let bounds = points_target.iter().fold(
+            (
+                Vector3::repeat(f64::INFINITY),
+                Vector3::repeat(f64::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+        );
         Self {
             points_target,
             spacing_m,
             radius_m,
+            bounds,
         }
     }
 
@@ -178,18 +245,20 @@ impl VisibilityModel {
             true => None,
             false => Some(MotionCompensation::from_prediction(prediction)?),
         };
-        let tolerance = config.tolerance_m as f32;
-        let keep: Vec<bool> = points
-            .iter()
-            .map(|p| {
-                let x = p.position();
-                let x = compensation
-                    .as_ref()
-                    .map_or(x, |c| c.position_at_end(&x, p.t));
-                !x.iter().all(|c| c.is_finite())
-                    || (x.norm() as f32) <= image.farthest_first_surface(&x) + tolerance
-            })
-            .collect();
+        let grow = self.margin_m(prediction, config) + config.tolerance_m;
+        let test = SurfaceTest {
+            image,
+            compensation,
+            tolerance_m: config.tolerance_m as f32,
+            t_target_sensor: prediction.pose.inverse(),
+            grown_box: config.outside_box.then(|| {
+                (
+                    self.bounds.0.add_scalar(-grow),
+                    self.bounds.1.add_scalar(grow),
+                )
+            }),
+        };
+        let keep: Vec<bool> = points.iter().map(|p| test.may_be_surface(p)).collect();
         let behind = keep.iter().filter(|k| !**k).count();
         let overruled = behind as f64 > config.max_dropped_fraction * points.len() as f64;
         let points = if overruled || behind == 0 {
@@ -212,13 +281,20 @@ impl VisibilityModel {
     /// puts it: the attitude allowance (or the prediction's 3σ) at the
     /// bounding radius, plus the prediction's 3σ in position.
     fn margin_m(&self, prediction: &Prediction, config: &VisibilityConfig) -> f64 {
-        let c = &prediction.covariance;
-        let finite_or_zero = |v: f64| if v.is_finite() { v.max(0.0) } else { 0.0 };
-        let sigma_rot = finite_or_zero(c[(0, 0)].max(c[(1, 1)]).max(c[(2, 2)])).sqrt();
-        let sigma_pos = finite_or_zero(c[(3, 3)] + c[(4, 4)] + c[(5, 5)]).sqrt();
+        let (sigma_rot, sigma_pos) = sigmas(prediction);
         let allow = config.pose_allowance_deg.to_radians().max(3.0 * sigma_rot);
         self.radius_m * allow.min(1.0).tan() + 3.0 * sigma_pos
     }
+}
+
+/// The prediction's worst-axis attitude σ (rad) and its position σ (m),
+/// 0 where not finite.
+fn sigmas(prediction: &Prediction) -> (f64, f64) {
+    let c = &prediction.covariance;
+    let finite_or_zero = |v: f64| if v.is_finite() { v.max(0.0) } else { 0.0 };
+    let sigma_rot = finite_or_zero(c[(0, 0)].max(c[(1, 1)]).max(c[(2, 2)])).sqrt();
+    let sigma_pos = finite_or_zero(c[(3, 3)] + c[(4, 4)] + c[(5, 5)]).sqrt();
+    (sigma_rot, sigma_pos)
 }
 
 #[cfg(test)]

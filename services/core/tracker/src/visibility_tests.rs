@@ -39,6 +39,14 @@ fn point(x: f64, y: f64, z: f64, t: f64) -> Point {
     Point::new(x as f32, y as f32, z as f32, 1.0, t)
 }
 
+/// The depth test alone (no bounding box).
+fn depth_only() -> VisibilityConfig {
+    VisibilityConfig {
+        outside_box: false,
+        ..VisibilityConfig::default()
+    }
+}
+
 /// The near face is at 14.5 m: points on it stay, a mirror ghost 2 m
 /// behind it goes, and points beside the target stay whatever their range.
 #[test]
@@ -55,7 +63,7 @@ fn ghosts_behind_the_near_face_are_dropped_and_surface_points_kept() {
             points.clone(),
             false,
             &prediction(Vector3::zeros()),
-            &VisibilityConfig::default(),
+            &depth_only(),
         )
         .unwrap();
     assert_eq!(gated.behind, 2);
@@ -76,12 +84,7 @@ fn beside_the_target_points_stay_and_near_the_rim_the_rim_bounds_them() {
         point(0.98, 0.0, 16.5, 1.0),
     ];
     let gated = model
-        .gate(
-            points,
-            false,
-            &prediction(Vector3::zeros()),
-            &VisibilityConfig::default(),
-        )
+        .gate(points, false, &prediction(Vector3::zeros()), &depth_only())
         .unwrap();
     assert_eq!(gated.behind, 1);
     assert!(gated.points.iter().all(|p| p.z < 16.0 || p.x > 2.0));
@@ -138,6 +141,42 @@ fn a_frame_mostly_behind_is_overruled_and_the_gate_can_be_switched_off() {
     assert_eq!((gated.behind, gated.points.len()), (0, 11));
 }
 
+/// With `outside_box`, a point beside the target beyond the grown box goes
+/// too (what holds the target: a facility's arm), one just outside the box
+/// within the tolerance stays; the box grows with the prediction's
+/// uncertainty, so a start-up's wide prediction keeps the arm.
+#[test]
+fn points_outside_the_grown_box_go() {
+    let model = VisibilityModel::new(&slab(), 0.075);
+    // Near face at z = 14.5; an arm below the slab (body y > 1), a return
+    // 10 cm past the edge, a surface return.
+    let points = vec![
+        point(0.0, 2.5, 14.8, 1.0),
+        point(0.0, 1.1, 14.6, 1.0),
+        point(0.0, 0.2, 14.51, 1.0),
+    ];
+    let sure = prediction(Vector3::zeros());
+    let gated = model
+        .gate(points.clone(), false, &sure, &VisibilityConfig::default())
+        .unwrap();
+    assert_eq!(gated.behind, 1);
+    assert!(gated.points.iter().all(|p| p.y < 2.0));
+    let kept = model
+        .gate(points.clone(), false, &sure, &depth_only())
+        .unwrap();
+    assert_eq!(kept.behind, 0);
+    // 60° (3σ) of attitude doubt, a start-up's, grows the box by
+    // 1.5 m tan 60° = 2.6 m: the arm stays.
+    let mut unsure = sure;
+    for i in 0..3 {
+        unsure.covariance[(i, i)] = (60f64 / 3.0).to_radians().powi(2);
+    }
+    let gated = model
+        .gate(points, false, &unsure, &VisibilityConfig::default())
+        .unwrap();
+    assert_eq!(gated.behind, 0);
+}
+
 #[test]
 fn the_config_fails_on_nan_and_out_of_range() {
     assert!(VisibilityConfig::default().validate().is_ok());
@@ -152,6 +191,10 @@ fn the_config_fails_on_nan_and_out_of_range() {
         },
         VisibilityConfig {
             max_dropped_fraction: 1.5,
+            ..VisibilityConfig::default()
+        },
+        VisibilityConfig {
+            refit_min_fraction: f64::NAN,
             ..VisibilityConfig::default()
         },
     ] {

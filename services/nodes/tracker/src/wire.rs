@@ -122,6 +122,7 @@ mod tests {
             fallback: false,
             start_up: false,
             points_behind: 0,
+            refit: false,
             held: None,
         };
         fill_estimate(&mut e, &out);

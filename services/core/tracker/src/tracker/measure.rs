@@ -1,9 +1,9 @@
 //! One frame's measurement: the frame path, the mode's registration and,
 //! when CT-NDT stalled, its fallback; or why there is none.
 
-use super::{Tracker, ms};
+use super::{Tracker, ms, scan_rate};
 use crate::assess::stalled;
-use crate::dispatch::LastPose;
+use crate::dispatch::{Fitted, LastPose};
 use crate::mode::TrackingMode;
 use crate::pipeline::Prepared;
 use crate::start_up::{FramePlan, frame_plan};
@@ -31,6 +31,9 @@ pub(super) struct Measured {
     pub(super) preprocess_ms: f64,
     /// Points the visibility gate dropped.
     pub(super) points_behind: usize,
+    /// Registered again on the cloud gated at the first fit
+    /// ([`crate::VisibilityConfig::refit`]).
+    pub(super) refit: bool,
     /// Registration, the fallback included.
     pub(super) registration_ms: f64,
 }
@@ -53,6 +56,41 @@ impl Missing {
             points_used: 0,
             preprocess_ms: 0.0,
         }
+    }
+}
+
+/// What a registration of the frame is given besides its cloud.
+#[derive(Clone, Copy)]
+struct FitContext<'a> {
+    plan: FramePlan,
+    compensated: bool,
+    prediction: &'a Prediction,
+    last: &'a LastPose,
+    scan: &'a ScanTimes,
+}
+
+/// The prediction the second gate uses: the fitted end pose and, where
+/// CT-NDT fitted the scan with two poses, the rate between them (the
+/// prediction's velocities otherwise), with no uncertainty of its own (the
+/// gate's `pose_allowance_deg` covers a fit's).
+fn fitted_prediction(prediction: &Prediction, fitted: &Fitted, scan: &ScanTimes) -> Prediction {
+    let start = fitted.t_target_sensor_start.as_ref();
+    let w_target = scan_rate(start, &fitted.registration, scan).unwrap_or(prediction.w_target);
+    let v_sensor = start
+        .map(|s| {
+            let p0 = s.inverse().translation;
+            let p1 = fitted.registration.t_sensor_target().translation;
+            (p1 - p0) / (scan.end_s - scan.start_s)
+        })
+        .filter(|v| v.iter().all(|c| c.is_finite()))
+        .unwrap_or(prediction.v_sensor);
+    Prediction {
+        t: scan.end_s,
+        pose: fitted.registration.t_sensor_target(),
+        v_sensor,
+        w_target,
+        covariance: nalgebra::Matrix6::zeros(),
+        ..*prediction
     }
 }
 
@@ -99,18 +137,26 @@ impl Tracker {
             .dispatch(plan)
             .register(&cloud, compensated, prediction, last, scan)
             .map_err(|e| Missing::because(e.to_string()))?;
-        let (registration, start) = (fitted.registration, fitted.t_target_sensor_start);
-        let fallback = self.stall_fallback(
-            points,
-            &registration,
-            (plan, compensated),
+        let context = FitContext {
+            plan,
+            compensated,
             prediction,
             last,
             scan,
-        );
+        };
+        let second = (self.config.visibility.refit && plan.start_up)
+            .then(|| self.refit(&cloud, &fitted, &context))
+            .flatten();
+        let refit = second.is_some();
+        let (fitted, points_behind, registered) = match second {
+            Some((fit, behind, kept)) => (fit, points_behind + behind, kept),
+            None => (fitted, points_behind, cloud.len()),
+        };
+        let (registration, start) = (fitted.registration, fitted.t_target_sensor_start);
+        let fallback = self.stall_fallback(points, &registration, &context);
         let (registration, compensated, points_used, fallback, start) = match fallback {
             Some((r, n)) => (r, true, n, true, None),
-            None => (registration, compensated, cloud.len(), false, start),
+            None => (registration, compensated, registered, false, start),
         };
         Ok(Measured {
             registration,
@@ -122,8 +168,47 @@ impl Tracker {
             t_target_sensor_start: start,
             preprocess_ms,
             points_behind,
+            refit,
             registration_ms: ms(reg_start),
         })
+    }
+
+    /// [`crate::VisibilityConfig::refit`], in the start-up: the gate again
+    /// on the registered `cloud`, at the pose (and, for CT-NDT, the scan's
+    /// motion) the `first` registration found, with the allowance of a
+    /// fitted pose rather than of a prediction. When it drops
+    /// `refit_min_fraction` of the cloud, the frame is registered again on
+    /// what it keeps, from the same guess and priors: the fit, not the
+    /// prediction, says where the surface is. Returns that fit, the points
+    /// the second gate dropped and the points it kept; `None` when there
+    /// was no second registration.
+    fn refit(
+        &mut self,
+        cloud: &[Point],
+        first: &Fitted,
+        c: &FitContext<'_>,
+    ) -> Option<(Fitted, usize, usize)> {
+        let at_fit = fitted_prediction(c.prediction, first, c.scan);
+        let config = &self.config.visibility;
+        let min_dropped = (config.refit_min_fraction * cloud.len() as f64)
+            .ceil()
+            .max(1.0);
+        let gated = self
+            .model
+            .visibility
+            .gate(cloud.to_vec(), c.compensated, &at_fit, config)
+            .ok()
+            .filter(|g| !g.overruled && g.behind as f64 >= min_dropped)?;
+        let second = self
+            .dispatch(c.plan)
+            .register(&gated.points, c.compensated, c.prediction, c.last, c.scan)
+            .ok()?;
+        tracing::debug!(
+            t = c.scan.end_s,
+            dropped = gated.behind,
+            "registered again on the cloud gated at the first fit"
+        );
+        Some((second, gated.behind, gated.points.len()))
     }
 
     /// The visibility gate ([`crate::visibility`]) on a prepared cloud: the
@@ -158,11 +243,15 @@ impl Tracker {
         &mut self,
         points: &[Point],
         registration: &Registration,
-        (plan, compensated): (FramePlan, bool),
-        prediction: &Prediction,
-        last: &LastPose,
-        scan: &ScanTimes,
+        context: &FitContext<'_>,
     ) -> Option<(Registration, usize)> {
+        let FitContext {
+            plan,
+            compensated,
+            prediction,
+            last,
+            scan,
+        } = *context;
         let c = &self.config;
         if plan.mode != TrackingMode::CtNdt
             || compensated

@@ -198,6 +198,7 @@ impl Tracker {
         out.fallback = m.fallback;
         out.start_up = m.mode != self.config.mode;
         out.points_behind = m.points_behind;
+        out.refit = m.refit;
         if out.status == TrackStatus::Tracking && scan_w.is_some() {
             self.scan_w_target = scan_w;
         }
@@ -323,6 +324,7 @@ impl Tracker {
             fallback: false,
             start_up: false,
             points_behind: 0,
+            refit: false,
             held,
         })
     }
@@ -361,7 +363,7 @@ impl Tracker {
 
 /// The angular velocity (target frame, rad/s) over a scan fitted with two
 /// poses: `Log(R_sᵀ R_e) / Δt` of `t_sensor_target` at its start and end.
-fn scan_rate(
+pub(crate) fn scan_rate(
     t_target_sensor_start: Option<&Pose>,
     registration: &Registration,
     scan: &ScanTimes,
