@@ -3,10 +3,12 @@
 # seeds of tools/eval/seeds.toml, 120 frames per run, on deos, from the
 # truth with zero rates (the start-up counts), and `acquired`: the deployed
 # path from a no-truth start (`--init acquire`: init's CNN, then template
-# matching, acquire on the frames and reacquire after a loss). `spacepose eval tables`
-# turns them into the table of docs/results.md.
+# matching, acquire on the frames and reacquire after a loss), and `clutter`
+# and `clutter-acquired`: the same with the test facility's background in
+# the frames (issue 25 item 6). `spacepose eval tables` turns them into the
+# table of docs/results.md.
 #   docs/results/monte-carlo/measure.sh <spacepose binary>
-# Each report takes 70-160 s on this project's 2-core machine (the twelve: about 20 minutes).
+# Each report takes 70-160 s on this project's 2-core machine (the sixteen: about 30 minutes).
 set -euo pipefail
 bin=$(realpath "$1")
 here=docs/results/monte-carlo
@@ -21,6 +23,8 @@ for sc in tumbling slow-spin; do
   run $sc all defaults
   run $sc deblur no-start-up no-start-up
   run $sc deblur,ct-ndt acquired "" --init acquire
+  run $sc deblur,ct-ndt clutter "" --clutter
+  run $sc deblur,ct-ndt clutter-acquired "" --clutter --init acquire
 done
 for sc in tumbling slow-spin; do
   for m in ndt deblur ct-ndt; do

@@ -84,6 +84,19 @@ pub struct EvalTrackingArgs {
     /// Scale applied to a mesh file's coordinates.
     #[arg(long, default_value_t = 1.0)]
     pub scale: f64,
+    /// The test facility's background in the frames (floor, back wall,
+    /// robot arm: seed 000 §4.1), which ingest must crop.
+    #[arg(long)]
+    pub clutter: bool,
+    /// The sensor's echo separation (m; `inf`: seed 004's average of every
+    /// echo of a beam). Default: the sensor's.
+    #[arg(long)]
+    pub echo_separation_m: Option<f64>,
+    /// The sensor's integration time per frame (s). Default: the frame
+    /// period (1 s, seed 000's continuous scanning); the suite's sensor
+    /// integrates 0.54 s.
+    #[arg(long)]
+    pub integration_time_s: Option<f64>,
     /// First frame of the scenario to run (the trackers start on the truth
     /// at that frame's scan start).
     #[arg(long, default_value_t = 0)]

@@ -25,13 +25,18 @@ pub fn simulate_batch(source: &FrameSource, first: u64, count: usize) -> Result<
 }
 
 /// The sensor's configuration for an evaluation: every sensor effect on,
-/// no facility clutter (in orbit there is none), an integration time of a
-/// whole frame period (the sensor scans continuously: seed 000 §4.1, 1 Hz
-/// frames of 1 s), and the truth acquisition of the first frame.
-pub fn sensor_config(base: LidarSimConfig, frame_period_s: f64) -> LidarSimConfig {
+/// the facility's background only when `clutter` (in orbit there is none),
+/// an integration time (a whole frame period when the sensor scans
+/// continuously: seed 000 §4.1, 1 Hz frames of 1 s), and the truth
+/// acquisition of the first frame.
+pub fn sensor_config(
+    base: LidarSimConfig,
+    integration_time_s: f64,
+    clutter: bool,
+) -> LidarSimConfig {
     LidarSimConfig {
-        integration_time_s: frame_period_s,
-        clutter: false,
+        integration_time_s,
+        clutter,
         truth_init: true,
         ..base
     }

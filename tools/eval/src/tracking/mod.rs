@@ -24,6 +24,7 @@
 pub mod acquisition;
 mod args;
 pub mod bounds;
+pub mod crop_score;
 pub mod deployed;
 pub mod filter_score;
 pub mod frames;
@@ -127,6 +128,7 @@ fn run_frames(
                 let output = answer.output.as_ref();
                 let mut r = report::record(frame, k as usize, &answer.estimate, output, symmetries);
                 r.blur_lag_deg = lag;
+                r.crop = crop_score::CropKinds::of_sent(frame, &answer.sent);
                 report::score_filter(&mut r, frame, answer.filter_state.as_ref(), symmetries);
                 r.acquisition = answer.acquisitions.last().map(|a| {
                     let truth = &frame.truth.t_sensor_target;
@@ -160,6 +162,7 @@ impl Tracked {
         TrackingReport {
             scenario: scenario.to_string(),
             target: target.to_string(),
+            clutter: config.clutter,
             seed: config.seed,
             frames,
             first_frame: config.first_frame,
@@ -199,6 +202,15 @@ fn run_report(args: &EvalTrackingArgs, config: &EvalConfig, path: &Path) -> Resu
     if args.init == EvalInit::Acquire {
         configuration += ", acquired by init";
     }
+    if args.clutter {
+        configuration += ", facility clutter";
+    }
+    if let Some(sep) = args.echo_separation_m {
+        configuration += &format!(", echo separation {sep} m");
+    }
+    if let Some(t) = args.integration_time_s {
+        configuration += &format!(", {t} s integration");
+    }
     let evaluate_seed = |seed| {
         evaluate(&EvalConfig {
             seed,
@@ -224,6 +236,9 @@ fn eval_config(args: &EvalTrackingArgs) -> Result<EvalConfig> {
         compression: args.compression,
         first_frame: args.first_frame,
         target: (args.target.clone(), args.scale),
+        clutter: args.clutter,
+        echo_separation_m: args.echo_separation_m,
+        integration_time_s: args.integration_time_s,
         warmup: args.warmup,
         min_lever_arm_m: args.min_lever_arm_m,
         geometric_sigma_m: args.geometric_sigma_m,

@@ -25,6 +25,8 @@ fn frame(frame: usize, status: TrackStatus, ang: f64, pos_cm: f64) -> FrameRecor
         points_in: 1000,
         points_used: 900,
         points_behind: 0,
+        crop: None,
+        refit: false,
         innovation_rot_deg: f64::NAN,
         nis: f64::NAN,
         reason: String::new(),

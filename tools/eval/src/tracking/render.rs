@@ -82,12 +82,17 @@ fn paper_row(name: &str, v: &[f64; 8]) -> Vec<String> {
 /// The run, the units and the scan blur, above the table.
 fn preamble(report: &TrackingReport) -> String {
     format!(
-        "{} with {}: {} frames from frame {} (seed {}, compression {}), {:.0} raw points per frame on average\n\
+        "{} with {}{}: {} frames from frame {} (seed {}, compression {}), {:.0} raw points per frame on average\n\
          errors in deg and cm; time in ms per frame, one thread, voxel filter included;\n\
          ang max* = max after {} warm-up frames; diverged = true error > {DIVERGED_DEG}° or {} cm\n\
          scan blur: the truth turns {:.2}° on average ({:.2}° max) between a frame's mean return time and its end\n",
         report.scenario,
         report.target,
+        if report.clutter {
+            ", facility clutter on"
+        } else {
+            ""
+        },
         report.frames,
         report.first_frame,
         report.seed,
@@ -293,6 +298,7 @@ mod tests {
         TrackingReport {
             scenario: "slow-spin".into(),
             target: "deos".into(),
+            clutter: false,
             seed: 7,
             frames: 100,
             first_frame: 0,

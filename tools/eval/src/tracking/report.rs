@@ -70,6 +70,12 @@ pub struct FrameRecord {
     /// Points the visibility gate dropped as lying behind the model at the
     /// prediction (`spacepose_tracker::visibility`).
     pub points_behind: usize,
+    /// What ingest's crop passed on, by kind of return (the simulator's
+    /// labels; null when the frame did not get through ingest).
+    pub crop: Option<super::crop_score::CropKinds>,
+    /// Registered again on the cloud gated at the first fit
+    /// (`spacepose_tracker::VisibilityConfig::refit`).
+    pub refit: bool,
     /// Attitude difference between the registration and the filter's
     /// prediction (deg; NaN without a registration).
     pub innovation_rot_deg: f64,
@@ -161,6 +167,8 @@ pub struct TrackingReport {
     pub scenario: String,
     /// Target name.
     pub target: String,
+    /// The test facility's background was in the frames.
+    pub clutter: bool,
     /// Seed.
     pub seed: u64,
     /// Frames run.
@@ -275,6 +283,8 @@ pub fn record(
         points_in: frame.points.len(),
         points_used: out.map_or(0, |o| o.points_used),
         points_behind: out.map_or(0, |o| o.points_behind),
+        crop: None,
+        refit: out.is_some_and(|o| o.refit),
         innovation_rot_deg: out.map_or(f64::NAN, |o| o.innovation_rot_deg),
         nis: out.map_or(f64::NAN, |o| o.nis),
         reason: out.map_or_else(String::new, |o| o.reason.clone()),

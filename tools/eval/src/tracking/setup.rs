@@ -30,6 +30,15 @@ pub struct EvalConfig {
     pub first_frame: usize,
     /// Target name or mesh path, and its scale.
     pub target: (String, f64),
+    /// The test facility's background (floor, back wall, robot arm) in the
+    /// frames, which ingest must crop (issue 25 item 6); off in orbit.
+    pub clutter: bool,
+    /// The sensor's echo separation (m; `inf`: seed 004's average of every
+    /// echo); `None`: the sensor's default.
+    pub echo_separation_m: Option<f64>,
+    /// The sensor's integration time per frame (s); `None`: the frame
+    /// period (1 s: seed 000's continuous scanning).
+    pub integration_time_s: Option<f64>,
     /// Frames excluded from the converged statistics.
     pub warmup: usize,
     /// Overrides the tracker's NDT `min_lever_arm_m` (and
@@ -65,6 +74,9 @@ impl EvalConfig {
             compression: 1.0,
             first_frame: 0,
             target,
+            clutter: false,
+            echo_separation_m: None,
+            integration_time_s: None,
             warmup: 10,
             min_lever_arm_m: None,
             geometric_sigma_m: None,
@@ -129,17 +141,22 @@ impl Setup {
 
 /// The sensor's frames for `config` (the simulated sensor's own source).
 pub fn frame_source(config: &EvalConfig) -> Result<FrameSource> {
+    let defaults = LidarSimConfig::default();
     let sensor = LidarSimConfig {
         target: config.target.0.clone(),
         scale: config.target.1,
         scenario: config.scenario,
         seed: config.seed,
         compression: config.compression,
-        ..LidarSimConfig::default()
+        echo_separation_m: config
+            .echo_separation_m
+            .unwrap_or(defaults.echo_separation_m),
+        ..defaults
     };
     // One frame period of integration: 1 s at the scenarios' 1 Hz.
     let period = sensor.frame_source()?.scenario().frame_period_s();
-    frames::sensor_config(sensor, period).frame_source()
+    let integration = config.integration_time_s.unwrap_or(period);
+    frames::sensor_config(sensor, integration, config.clutter).frame_source()
 }
 
 /// The services' configurations: the defaults, the target's crop, and the
