@@ -118,6 +118,7 @@ pub fn print(report: &CnnReport, frames: bool) {
     println!("\nTable IV (one thread)");
     print!("{}", render::table4(&report.time_ms).render());
     println!("\n{}", render::fconv_line(&report.fconv));
+    println!("{}", render::acceptance_line(report));
     print!("\n{}", render::range_table(&report.by_range).render());
     if frames {
         print!("\n{}", render::frames_table(&report.frames).render());

@@ -97,15 +97,36 @@ pub fn fconv_line(f: &FconvStats) -> String {
     )
 }
 
+/// What init hands the tracker: accepted and correct, and false accepts
+/// (a wrong pose accepted as a success), over every frame.
+pub fn acceptance_line(report: &CnnReport) -> String {
+    format!(
+        "handed to the tracker: accepted and correct {}%, false accepts {}% ({} of {} frames)",
+        pct(report.accepted_correct_rate),
+        pct(report.false_accept_rate),
+        report.fconv.false_accepts,
+        report.count
+    )
+}
+
 /// Success by range.
 pub fn range_table(bins: &[RangeBin]) -> Table {
-    let mut t = Table::new(&["range [m]", "frames", "raw [%]", "refined [%]"]);
+    let mut t = Table::new(&[
+        "range [m]",
+        "frames",
+        "raw [%]",
+        "refined [%]",
+        "accepted and correct [%]",
+        "false accepts [%]",
+    ]);
     for b in bins {
         t.row(vec![
             format!("{}-{}", b.range_m[0], b.range_m[1]),
             b.frames.to_string(),
             pct(b.success_rate_raw),
             pct(b.success_rate_refined),
+            pct(b.accepted_correct_rate),
+            pct(b.false_accept_rate),
         ]);
     }
     t

@@ -162,6 +162,12 @@ pub struct RangeBin {
     pub success_rate_refined: f64,
     /// Raw successes over frames.
     pub success_rate_raw: f64,
+    /// Accepted (f_CONV) and a refined success, over frames: what init
+    /// hands the tracker that it may use.
+    pub accepted_correct_rate: f64,
+    /// Accepted and not a refined success, over frames: a wrong pose
+    /// handed to the tracker as a success.
+    pub false_accept_rate: f64,
 }
 
 /// Summary of an `eval cnn` run.
@@ -181,6 +187,12 @@ pub struct CnnReport {
     pub success_rate_refined: f64,
     /// Network successes over frames.
     pub success_rate_raw: f64,
+    /// Accepted (f_CONV) and a refined success, over frames (issue 25
+    /// item 4): what init hands the tracker that it may use.
+    pub accepted_correct_rate: f64,
+    /// Accepted and not a refined success, over frames: a wrong pose handed
+    /// to the tracker as a success.
+    pub false_accept_rate: f64,
     /// Attitude errors over the successes (deg).
     pub ang_err_deg: RawRefined,
     /// Position errors over the successes (cm).

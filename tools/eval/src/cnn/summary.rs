@@ -25,6 +25,8 @@ pub fn report(
         count: frames.len(),
         success_rate_refined: rate(&frames, |r| r.success_refined),
         success_rate_raw: rate(&frames, |r| r.success_raw),
+        accepted_correct_rate: rate(&frames, accepted_correct),
+        false_accept_rate: rate(&frames, false_accept),
         ang_err_deg: raw_refined(&frames, |r| r.raw_err_deg, |r| r.err_deg),
         pos_err_cm: raw_refined(&frames, |r| r.raw_err_cm, |r| r.err_cm),
         time_ms: time_split(&frames),
@@ -44,6 +46,16 @@ pub fn report(
         config,
         frames,
     }
+}
+
+/// Accepted by the f_CONV check and a refined success.
+fn accepted_correct(r: &CnnFrame) -> bool {
+    r.accepted && r.success_refined
+}
+
+/// Accepted by the f_CONV check and not a refined success.
+fn false_accept(r: &CnnFrame) -> bool {
+    r.accepted && !r.success_refined
 }
 
 /// Frames for which `keep` holds.
@@ -113,7 +125,7 @@ fn fconv_stats(frames: &[CnnFrame], f_max_m2: f64) -> FconvStats {
     FconvStats {
         f_max_m2,
         accepted_rate: rate(frames, |r| r.accepted),
-        false_accepts: count(frames, |r| r.accepted && !r.success_refined),
+        false_accepts: count(frames, false_accept),
         false_rejects: count(frames, |r| !r.accepted && r.success_refined),
         success_max_m2: s.iter().copied().fold(f64::NAN, f64::max),
         success_median_m2: median(&s),
@@ -144,6 +156,8 @@ fn range_bin(frames: &[CnnFrame], lo: f64, hi: f64) -> RangeBin {
         frames: bin.len(),
         success_rate_refined: bin.iter().filter(|r| r.success_refined).count() as f64 / k,
         success_rate_raw: bin.iter().filter(|r| r.success_raw).count() as f64 / k,
+        accepted_correct_rate: bin.iter().filter(|r| accepted_correct(r)).count() as f64 / k,
+        false_accept_rate: bin.iter().filter(|r| false_accept(r)).count() as f64 / k,
     }
 }
 
@@ -187,5 +201,15 @@ mod tests {
         assert_eq!(bins.iter().map(|b| b.frames).sum::<usize>(), ranges.len());
         assert_eq!(bins[0].success_rate_refined, 1.0);
         assert_eq!(bins[3].success_rate_refined, 0.0);
+        // Every frame is accepted: the successes are accepted and correct,
+        // the failures false accepts.
+        assert_eq!(
+            (bins[0].accepted_correct_rate, bins[0].false_accept_rate),
+            (1.0, 0.0)
+        );
+        assert_eq!(
+            (bins[3].accepted_correct_rate, bins[3].false_accept_rate),
+            (0.0, 1.0)
+        );
     }
 }
