@@ -97,6 +97,9 @@ pub struct DatasetStats {
 #[derive(Debug)]
 pub struct Generator {
     target: Arc<Target>,
+    /// The target the frames are simulated of: `target` itself, or the
+    /// target as built ([`Generator::outside_training`]).
+    world: Arc<Target>,
     sensor: SensorConfig,
     domain: DomainConfig,
     preprocess: PreprocessConfig,
@@ -126,10 +129,33 @@ impl Generator {
             domain: DomainConfig::seed004(target.bounding_radius(), fov_deg),
             preprocess: PreprocessConfig::for_target(&target, config.image_size)?,
             classes: ClassTable::for_target(&target, config.roll_step_deg)?,
+            world: target.clone(),
             target,
             sensor,
             config,
         })
+    }
+
+    /// This generator's frames made outside what the network was trained
+    /// on (issue 25 item 3): simulated of `world` (the target as built,
+    /// `spacepose_model::AsBuilt`) while the labels, the class table and
+    /// the preprocessing stay the model's, by `sensor` instead of the
+    /// default Mid-40, with angular rates up to `max_rate_deg_s` (seed
+    /// 004 trains up to 5°/s).
+    ///
+    /// # Errors
+    /// A sensor or target the simulator refuses.
+    pub fn outside_training(
+        mut self,
+        world: Arc<Target>,
+        sensor: SensorConfig,
+        max_rate_deg_s: f64,
+    ) -> Result<Self, CnnError> {
+        LidarSimulator::new(world.clone(), sensor.clone())?;
+        self.world = world;
+        self.sensor = sensor;
+        self.domain.max_rate_deg_s = max_rate_deg_s;
+        Ok(self)
     }
 
     /// The class table.
@@ -176,7 +202,7 @@ impl Generator {
             let draw = draw_frame(&self.domain, self.sensor.points_per_second, &mut rng);
             let mut sensor = self.sensor.clone();
             sensor.integration_time_s = draw.integration_time_s;
-            let sim = LidarSimulator::new(self.target.clone(), sensor)?;
+            let sim = LidarSimulator::new(self.world.clone(), sensor)?;
             let frame = sim.try_simulate(&draw.truth, &mut rng)?;
             if frame.points.len() < self.config.min_points {
                 continue;

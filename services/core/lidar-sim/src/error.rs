@@ -30,6 +30,10 @@ pub enum SimError {
     /// The truth state holds a NaN or infinite number.
     #[error("truth state is not finite (t = {0})")]
     NonFiniteTruth(f64),
+    /// The world's departures from the model ([`crate::Mismatch`]) are
+    /// invalid or the as-built target cannot be built.
+    #[error("mismatch: {0}")]
+    Mismatch(String),
     /// A material cannot be drawn, or a mesh face refers to a material the
     /// target does not define.
     #[error("target `{target}` ({materials} materials): {reason}")]

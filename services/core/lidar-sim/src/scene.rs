@@ -3,6 +3,7 @@
 //! tracing of one beam (divergent rays, direct and reflected echoes).
 
 use crate::echoes::{BeamEchoes, Echo};
+use crate::mismatch::ScanPath;
 use crate::optics::{Cone, cos_pow, divergence_weight, mirror, phong_backscatter, sample_cone};
 use crate::surface::Surface;
 use nalgebra::{Rotation3, Vector3};
@@ -10,12 +11,20 @@ use rand_chacha::ChaCha8Rng;
 use spacepose_geometry::so3;
 use spacepose_model::{Mesh, Target};
 
-/// Motion of the target during a scan: the scan-end truth extrapolated
-/// backwards with constant velocity (seed 000 Eq. 8) and constant angular
-/// velocity in the body frame (Eq. 9): `R(t) = R_end Exp(ω (t - t_end))`,
-/// `p(t) = p_end + v (t - t_end)`.
+/// Motion of the target during a scan.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct TargetMotion {
+pub(crate) enum TargetMotion<'a> {
+    /// The scan-end truth extrapolated backwards with constant velocity
+    /// (seed 000 Eq. 8) and angular velocity (Eq. 9): the motion the
+    /// filter assumes.
+    Constant(ConstantMotion),
+    /// The world's own motion, sampled over the scan ([`crate::mismatch`]).
+    Sampled(&'a ScanPath),
+}
+
+/// `R(t) = R_end Exp(ω (t - t_end))`, `p(t) = p_end + v (t - t_end)`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ConstantMotion {
     /// Scan-end rotation body → sensor.
     pub r_sensor_target: Rotation3<f64>,
     /// Scan-end position of the centre of mass in the sensor frame.
@@ -30,22 +39,24 @@ pub(crate) struct TargetMotion {
     pub blur: bool,
 }
 
-impl TargetMotion {
+impl TargetMotion<'_> {
     #[inline]
     fn position(&self, t: f64) -> Vector3<f64> {
-        if self.blur {
-            self.t_sensor_target + self.v_sensor * (t - self.t_end)
-        } else {
-            self.t_sensor_target
+        match self {
+            TargetMotion::Constant(m) if m.blur => m.t_sensor_target + m.v_sensor * (t - m.t_end),
+            TargetMotion::Constant(m) => m.t_sensor_target,
+            TargetMotion::Sampled(path) => path.position(t),
         }
     }
 
     #[inline]
     fn rotation(&self, t: f64) -> Rotation3<f64> {
-        if self.blur {
-            self.r_sensor_target * so3::exp(&(self.w_target * (t - self.t_end)))
-        } else {
-            self.r_sensor_target
+        match self {
+            TargetMotion::Constant(m) if m.blur => {
+                m.r_sensor_target * so3::exp(&(m.w_target * (t - m.t_end)))
+            }
+            TargetMotion::Constant(m) => m.r_sensor_target,
+            TargetMotion::Sampled(path) => path.rotation(t),
         }
     }
 }
@@ -115,7 +126,7 @@ impl RayEchoes {
 /// Everything fixed during one frame.
 pub(crate) struct FrameScene<'a> {
     pub target: &'a Target,
-    pub motion: TargetMotion,
+    pub motion: TargetMotion<'a>,
     /// Per-material draws of this frame, indexed by `MaterialId`.
     pub surfaces: Vec<Surface>,
     /// Facility background meshes (sensor frame); empty without clutter.

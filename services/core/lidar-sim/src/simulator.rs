@@ -6,8 +6,9 @@ use crate::config::{SensorConfig, SurfaceModel};
 use crate::detection::DetectionModel;
 use crate::error::SimError;
 use crate::measurement::Measurement;
+use crate::mismatch::ScanPath;
 use crate::pattern::Scan;
-use crate::scene::{FrameScene, TargetMotion};
+use crate::scene::{ConstantMotion, FrameScene, TargetMotion};
 use crate::surface::{Surface, draw_surfaces, validate_materials};
 use nalgebra::Vector3;
 use rand::SeedableRng;
@@ -112,6 +113,37 @@ impl LidarSimulator {
         truth: &TruthState,
         rng: &mut ChaCha8Rng,
     ) -> Result<Frame, SimError> {
+        let motion = TargetMotion::Constant(scan_motion(truth, self.config.effects.motion_blur));
+        self.simulate_moving(truth, motion, rng)
+    }
+
+    /// One scan ending at `truth.t` with the target moving along `path`
+    /// (the world's own motion: [`crate::mismatch`]) instead of the
+    /// constant velocities of `truth`; `path` should cover the scan window
+    /// `[truth.t - integration_time_s, truth.t]`. Motion blur off holds
+    /// the target at the path's scan-end pose.
+    ///
+    /// # Errors
+    /// A non-finite truth state.
+    pub fn try_simulate_along(
+        &self,
+        truth: &TruthState,
+        path: &ScanPath,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Frame, SimError> {
+        let motion = match self.config.effects.motion_blur {
+            true => TargetMotion::Sampled(path),
+            false => TargetMotion::Constant(scan_motion(truth, false)),
+        };
+        self.simulate_moving(truth, motion, rng)
+    }
+
+    fn simulate_moving(
+        &self,
+        truth: &TruthState,
+        motion: TargetMotion<'_>,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Frame, SimError> {
         if !truth_is_finite(truth) {
             return Err(SimError::NonFiniteTruth(truth.t));
         }
@@ -120,7 +152,7 @@ impl LidarSimulator {
         let scan = c
             .pattern
             .scan(truth.t, c.integration_time_s, c.points_per_second, rng);
-        let scene = self.frame_scene(truth, rng);
+        let scene = self.frame_scene(truth, motion, rng);
         let (points, kinds) = self.measure_scan(&scan, &scene, rng);
         Ok(Frame {
             points,
@@ -135,12 +167,17 @@ impl LidarSimulator {
     /// `truth`'s velocities, this frame's surface draws (the only random
     /// draws here), the facility background if `Effects::clutter`, and the
     /// beam (divergence, reflections) as the effects ask.
-    fn frame_scene(&self, truth: &TruthState, rng: &mut ChaCha8Rng) -> FrameScene<'_> {
+    fn frame_scene<'a>(
+        &'a self,
+        truth: &TruthState,
+        motion: TargetMotion<'a>,
+        rng: &mut ChaCha8Rng,
+    ) -> FrameScene<'a> {
         let c = &self.config;
         let fx = c.effects;
         FrameScene {
             target: &self.target,
-            motion: scan_motion(truth, fx.motion_blur),
+            motion,
             surfaces: self.frame_surfaces(rng),
             clutter: if fx.clutter {
                 c.facility.build(&self.target, &truth.t_sensor_target)
@@ -193,8 +230,8 @@ impl LidarSimulator {
 /// The target's motion during the scan ending at `truth.t`: `truth`'s pose
 /// extrapolated backwards with its constant velocity (seed 000 Eq. 8) and
 /// angular velocity (Eq. 9) when `blur`, else held at the scan-end pose.
-fn scan_motion(truth: &TruthState, blur: bool) -> TargetMotion {
-    TargetMotion {
+fn scan_motion(truth: &TruthState, blur: bool) -> ConstantMotion {
+    ConstantMotion {
         r_sensor_target: truth.t_sensor_target.rotation,
         t_sensor_target: truth.t_sensor_target.translation,
         v_sensor: truth.v_sensor_target,

@@ -7,6 +7,7 @@
 //! §3.1) and a DEOS-like client (seed 004 §III.C.4). Other targets load from STL, OBJ or PLY.
 #![forbid(unsafe_code)]
 
+pub mod as_built;
 pub mod builtin;
 pub mod consistency;
 mod error;
@@ -20,6 +21,7 @@ pub mod symmetry;
 mod target;
 pub mod zoo;
 
+pub use as_built::AsBuilt;
 pub use consistency::{RangeMargin, RayConsistency, ray_consistency};
 pub use error::TargetError;
 pub use material::{Material, MaterialClass, MaterialId};

@@ -3,7 +3,7 @@
 
 use anyhow::Context;
 use serde::Deserialize;
-use spacepose_lidar_sim::{FrameSource, SensorConfig};
+use spacepose_lidar_sim::{FrameSource, Mismatch, SensorConfig};
 use spacepose_runtime::ServiceConfig;
 use spacepose_scenario::{LookAway, ScenarioConfig, ScenarioKind};
 use std::path::PathBuf;
@@ -43,6 +43,12 @@ pub struct LidarSimConfig {
     /// and the strongest is reported; `inf` averages them all, as seed 004
     /// does (`SensorConfig::echo_separation_m`).
     pub echo_separation_m: f64,
+    /// The world departs from the estimators' model (the `[mismatch]`
+    /// table, `spacepose_lidar_sim::Mismatch`): the target as built, and
+    /// the scenario's own motion with the chaser's jitter and acceleration
+    /// within each scan. Absent: the model's mesh moving with constant
+    /// velocities over the scan.
+    pub mismatch: Option<Mismatch>,
     /// Publish an acquisition result from the truth for the first frame.
     pub truth_init: bool,
     /// After the last frame (frames > 0): exit, or stay up sending heartbeats.
@@ -77,6 +83,7 @@ impl Default for LidarSimConfig {
             rate_hz: 1.0,
             clutter: true,
             echo_separation_m: spacepose_lidar_sim::config::DEFAULT_ECHO_SEPARATION_M,
+            mismatch: None,
             truth_init: false,
             exit_at_end: false,
             sensor_id: 0,
@@ -108,6 +115,9 @@ impl ServiceConfig for LidarSimConfig {
         }
         if let Some(look) = &self.look_away {
             look.validate().map_err(|e| e.to_string())?;
+        }
+        if let Some(m) = &self.mismatch {
+            m.validate()?;
         }
         if !(self.range_scale.is_finite() && self.range_scale >= 1.0) {
             return Err(format!(
@@ -155,7 +165,11 @@ impl LidarSimConfig {
         sensor.integration_time_s = self.integration_time_s;
         sensor.effects.clutter = self.clutter;
         sensor.echo_separation_m = self.echo_separation_m;
-        FrameSource::new(Arc::new(target), scenario, sensor, self.seed).context("invalid sensor")
+        match &self.mismatch {
+            None => FrameSource::new(Arc::new(target), scenario, sensor, self.seed),
+            Some(m) => FrameSource::with_mismatch(&target, scenario, sensor, self.seed, m.clone()),
+        }
+        .context("invalid sensor or mismatch")
     }
 
     /// The frame period (ns); `None` when frames go out as fast as they are
@@ -188,6 +202,18 @@ mod tests {
         };
         assert_eq!(c, defaults);
         LidarSimConfig::default().validate().unwrap();
+    }
+
+    #[test]
+    fn a_mismatch_table_takes_defaults_and_refuses_bad_keys() {
+        let c: LidarSimConfig = toml::from_str("[mismatch]\njitter_deg = 0.05\n").unwrap();
+        c.validate().unwrap();
+        let m = c.mismatch.unwrap();
+        assert_eq!(m.jitter_deg, 0.05);
+        assert_eq!(m.as_built, spacepose_model::AsBuilt::default());
+        assert!(toml::from_str::<LidarSimConfig>("[mismatch]\njitter = 0.05\n").is_err());
+        let bad: LidarSimConfig = toml::from_str("[mismatch.as_built]\nrelief_m = nan\n").unwrap();
+        assert!(bad.validate().is_err());
     }
 
     #[test]
