@@ -36,6 +36,27 @@ pub const TRAINING_SEEDS: [u64; 3] = [1, 2, 90];
 /// Frames simulated in parallel before they are estimated in turn.
 const CHUNK: usize = 64;
 
+/// Range noise of the frames outside the training, over the Mid-40's.
+const MISMATCH_NOISE_FACTOR: f64 = 1.5;
+/// Largest angular rate of the frames outside the training (deg/s).
+const MISMATCH_MAX_RATE_DEG_S: f64 = 10.0;
+
+/// `generator` making frames of `target` as built (seeded by `seed`), with
+/// [`MISMATCH_NOISE_FACTOR`] times the range noise and rates up to
+/// [`MISMATCH_MAX_RATE_DEG_S`].
+fn outside_training(
+    generator: Generator,
+    target: &spacepose_model::Target,
+    seed: u64,
+) -> Result<Generator> {
+    let world = spacepose_model::AsBuilt::default()
+        .apply(target, seed)
+        .context("building the target as built")?;
+    let mut sensor = spacepose_lidar_sim::SensorConfig::livox_mid40();
+    sensor.range_sigma_m *= MISMATCH_NOISE_FACTOR;
+    Ok(generator.outside_training(std::sync::Arc::new(world), sensor, MISMATCH_MAX_RATE_DEG_S)?)
+}
+
 /// Generates the held-out set and scores every estimate.
 pub fn evaluate(args: &EvalCnnArgs) -> Result<CnnReport> {
     if TRAINING_SEEDS.contains(&args.seed) {
@@ -82,6 +103,10 @@ pub fn evaluate(args: &EvalCnnArgs) -> Result<CnnReport> {
             min_points: DEFAULT_MIN_POINTS,
         },
     )?;
+    let generator = match args.mismatch {
+        false => generator,
+        true => outside_training(generator, &target, args.seed)?,
+    };
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = args.sim_threads {
         pool = pool.num_threads(t);

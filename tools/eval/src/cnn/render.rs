@@ -9,12 +9,17 @@ use crate::table::{Table, num, sci};
 /// hypotheses and the twin check.
 pub fn summary_line(report: &CnnReport) -> String {
     format!(
-        "CNN pose estimation, {} held-out frames (seed {}), target {}, model {}, engine {} (one thread); \
+        "CNN pose estimation, {} held-out frames (seed {}{}), target {}, model {}, engine {} (one thread); \
          mean {:.0} points per frame; {} estimator errors; {} frames refined several \
          hypotheses, {} reported a hypothesis other than Γ_sym's (max {}); twin check: \
          {} frames refined a twin, {} reported it",
         report.count,
         report.seed,
+        if report.mismatch {
+            "; outside the training: the target as built, 1.5x range noise, up to 10°/s"
+        } else {
+            ""
+        },
         report.target,
         report.model,
         report.engine,

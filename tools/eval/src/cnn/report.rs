@@ -181,6 +181,8 @@ pub struct CnnReport {
     pub engine: String,
     /// Seed of the held-out set.
     pub seed: u64,
+    /// The frames came from outside the training (`--mismatch`).
+    pub mismatch: bool,
     /// Frames.
     pub count: usize,
     /// Refined successes over frames.

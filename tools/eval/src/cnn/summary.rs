@@ -22,6 +22,7 @@ pub fn report(
         model: model.display().to_string(),
         engine: estimator.engine().to_string(),
         seed: args.seed,
+        mismatch: args.mismatch,
         count: frames.len(),
         success_rate_refined: rate(&frames, |r| r.success_refined),
         success_rate_raw: rate(&frames, |r| r.success_raw),

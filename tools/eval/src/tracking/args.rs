@@ -97,6 +97,14 @@ pub struct EvalTrackingArgs {
     /// integrates 0.54 s.
     #[arg(long)]
     pub integration_time_s: Option<f64>,
+    /// Model mismatch (issue 25 item 3): the frames show the target as
+    /// built (MLI relief, appendages missing from the model, 1 % scale
+    /// errors, a displaced centre of mass) moving with the scenario's own
+    /// motion within each scan plus the chaser's attitude jitter and an
+    /// acceleration; the services keep the nominal package
+    /// (`spacepose_lidar_sim::Mismatch`'s defaults).
+    #[arg(long)]
+    pub mismatch: bool,
     /// First frame of the scenario to run (the trackers start on the truth
     /// at that frame's scan start).
     #[arg(long, default_value_t = 0)]

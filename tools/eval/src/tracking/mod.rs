@@ -163,6 +163,7 @@ impl Tracked {
             scenario: scenario.to_string(),
             target: target.to_string(),
             clutter: config.clutter,
+            mismatch: config.mismatch.is_some(),
             seed: config.seed,
             frames,
             first_frame: config.first_frame,
@@ -211,6 +212,9 @@ fn run_report(args: &EvalTrackingArgs, config: &EvalConfig, path: &Path) -> Resu
     if let Some(t) = args.integration_time_s {
         configuration += &format!(", {t} s integration");
     }
+    if args.mismatch {
+        configuration += ", model mismatch";
+    }
     let evaluate_seed = |seed| {
         evaluate(&EvalConfig {
             seed,
@@ -239,6 +243,7 @@ fn eval_config(args: &EvalTrackingArgs) -> Result<EvalConfig> {
         clutter: args.clutter,
         echo_separation_m: args.echo_separation_m,
         integration_time_s: args.integration_time_s,
+        mismatch: args.mismatch.then(spacepose_lidar_sim::Mismatch::default),
         warmup: args.warmup,
         min_lever_arm_m: args.min_lever_arm_m,
         geometric_sigma_m: args.geometric_sigma_m,

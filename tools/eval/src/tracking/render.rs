@@ -88,10 +88,11 @@ fn preamble(report: &TrackingReport) -> String {
          scan blur: the truth turns {:.2}° on average ({:.2}° max) between a frame's mean return time and its end\n",
         report.scenario,
         report.target,
-        if report.clutter {
-            ", facility clutter on"
-        } else {
-            ""
+        match (report.clutter, report.mismatch) {
+            (false, false) => "",
+            (true, false) => ", facility clutter on",
+            (false, true) => ", model mismatch",
+            (true, true) => ", facility clutter on, model mismatch",
         },
         report.frames,
         report.first_frame,
@@ -299,6 +300,7 @@ mod tests {
             scenario: "slow-spin".into(),
             target: "deos".into(),
             clutter: false,
+            mismatch: false,
             seed: 7,
             frames: 100,
             first_frame: 0,

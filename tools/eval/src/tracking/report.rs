@@ -169,6 +169,8 @@ pub struct TrackingReport {
     pub target: String,
     /// The test facility's background was in the frames.
     pub clutter: bool,
+    /// The world departed from the model (`--mismatch`).
+    pub mismatch: bool,
     /// Seed.
     pub seed: u64,
     /// Frames run.

@@ -39,6 +39,10 @@ pub struct EvalConfig {
     /// The sensor's integration time per frame (s); `None`: the frame
     /// period (1 s: seed 000's continuous scanning).
     pub integration_time_s: Option<f64>,
+    /// The world departs from the model (issue 25 item 3): the target as
+    /// built and its own motion within the scans; the services keep the
+    /// nominal package.
+    pub mismatch: Option<spacepose_lidar_sim::Mismatch>,
     /// Frames excluded from the converged statistics.
     pub warmup: usize,
     /// Overrides the tracker's NDT `min_lever_arm_m` (and
@@ -77,6 +81,7 @@ impl EvalConfig {
             clutter: false,
             echo_separation_m: None,
             integration_time_s: None,
+            mismatch: None,
             warmup: 10,
             min_lever_arm_m: None,
             geometric_sigma_m: None,
@@ -151,6 +156,7 @@ pub fn frame_source(config: &EvalConfig) -> Result<FrameSource> {
         echo_separation_m: config
             .echo_separation_m
             .unwrap_or(defaults.echo_separation_m),
+        mismatch: config.mismatch.clone(),
         ..defaults
     };
     // One frame period of integration: 1 s at the scenarios' 1 Hz.
