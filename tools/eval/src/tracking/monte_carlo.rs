@@ -10,7 +10,7 @@
 use super::acquisition::AcquisitionCounts;
 use super::nees::NeesSummary;
 use super::report::{FrameRecord, TrackingReport};
-use anyhow::Result;
+use anyhow::{Context, Result};
 use rayon::prelude::*;
 use serde::Serialize;
 use spacepose_tracker::TrackStatus;
@@ -103,22 +103,36 @@ pub struct MonteCarloReport {
 }
 
 /// Runs `evaluate` (one evaluation of a seed) on every seed of `seeds`
-/// (two at a time on this machine's cores; each run's frames are simulated
-/// in parallel too) and reduces the runs.
+/// (as many at a time as the machine has cores; each run's frames are
+/// simulated in parallel too) and reduces the runs.
+///
+/// The seeds run on a pool of their own, not rayon's global one: a run
+/// from init's acquisitions waits (sleeping) for init's worker thread,
+/// whose template matching runs on the global pool. With the seeds on the
+/// global pool, every worker of it could be such a wait, and the matching
+/// would never run (it deadlocked with the facility clutter on, where
+/// template matching takes over from the CNN).
 pub fn monte_carlo(
     evaluate: impl Fn(u64) -> Result<TrackingReport> + Sync,
     seed_set: &str,
     seeds: &[u64],
     configuration: &str,
 ) -> Result<MonteCarloReport> {
-    let runs: Vec<TrackingReport> = seeds
-        .par_iter()
-        .map(|&seed| {
-            let run = evaluate(seed);
-            tracing::info!(seed, ok = run.is_ok(), "Monte-Carlo run done");
-            run
-        })
-        .collect::<Result<_>>()?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(rayon::current_num_threads())
+        .thread_name(|i| format!("monte-carlo-{i}"))
+        .build()
+        .context("building the Monte-Carlo thread pool")?;
+    let runs: Vec<TrackingReport> = pool.install(|| {
+        seeds
+            .par_iter()
+            .map(|&seed| {
+                let run = evaluate(seed);
+                tracing::info!(seed, ok = run.is_ok(), "Monte-Carlo run done");
+                run
+            })
+            .collect::<Result<_>>()
+    })?;
     anyhow::ensure!(!runs.is_empty(), "no seed to run");
     let first = &runs[0];
     let mut modes = BTreeMap::new();

@@ -95,3 +95,27 @@ fn spread_gives_mean_p95_max_and_a_t_interval() {
     assert!(spread(&[1.0, f64::NAN]).mean.is_nan());
     assert!(spread(&[]).max.is_nan());
 }
+
+#[test]
+fn a_run_that_waits_on_a_thread_using_rayon_does_not_deadlock() {
+    // The shape of a run from init's acquisitions: the run sleeps until
+    // another thread's parallel work (template matching) is done.
+    let evaluate = |seed: u64| -> Result<TrackingReport> {
+        let worker = std::thread::spawn(|| (0..10_000u64).into_par_iter().sum::<u64>());
+        while !worker.is_finished() {
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        let sum = worker.join().map_err(|_| anyhow::anyhow!("worker panicked"))?;
+        Err(anyhow::anyhow!("seed {seed}: {sum}"))
+    };
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let seeds: Vec<u64> = (1..=8).collect();
+        let _ = tx.send(monte_carlo(evaluate, "test", &seeds, "").map(|_| ()));
+    });
+    let result = rx
+        .recv_timeout(std::time::Duration::from_secs(60))
+        .expect("the Monte-Carlo deadlocked");
+    let error = result.expect_err("every run failed").to_string();
+    assert!(error.contains("49995000"), "{error}");
+}
