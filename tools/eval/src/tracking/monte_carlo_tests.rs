@@ -105,7 +105,9 @@ fn a_run_that_waits_on_a_thread_using_rayon_does_not_deadlock() {
         while !worker.is_finished() {
             std::thread::sleep(std::time::Duration::from_millis(1));
         }
-        let sum = worker.join().map_err(|_| anyhow::anyhow!("worker panicked"))?;
+        let sum = worker
+            .join()
+            .map_err(|_| anyhow::anyhow!("worker panicked"))?;
         Err(anyhow::anyhow!("seed {seed}: {sum}"))
     };
     let (tx, rx) = std::sync::mpsc::channel();
