@@ -280,9 +280,13 @@ fn demo_on_a_generated_target_needs_no_descriptor() {
 }
 
 /// The same goals with the test-facility background that ingest must crop
-/// (deploy/examples/demo-clutter.toml).
+/// (deploy/examples/demo-clutter.toml): init acquires on ingest's detection
+/// crop, which keeps the top of the robot arm, and its pose can be 10-25°
+/// off. The tracker's first registration then restarts the filter at its
+/// own pose (docs/design/acquisition-seed.md), so that error does not
+/// become a rate; before that rule this run published 8-10 of 20 frames
+/// `tracking`, the others degraded or lost.
 #[test]
-#[ignore = "fails: with the facility clutter on, init acquires on the detection crop, which keeps the top of the robot arm; template matching then accepts wrong poses (tumbling clutter-acquired Monte-Carlo, 21 blind seeds: 21 false accepts of 278 attempts) and the track from one is published as tracking while far off. Issue 25 items 4 and 6"]
 fn demo_with_clutter_meets_the_tracking_goals() {
     let (s, all) = demo_summary(
         "clutter",

@@ -26,8 +26,9 @@ use spacepose_runtime::ServiceConfig;
 pub enum EstimateOutcome {
     /// Fused into the filter: publish the new state.
     Fused,
-    /// The estimate refers to the time the filter was (re)initialised at,
-    /// before any update: it replaced the initial pose. Publish the state.
+    /// The first registration after an acquisition (or one of the frame
+    /// the filter was initialised at, before any update): it replaced the
+    /// initial pose, with zero rates, at its own time. Publish the state.
     Reinitialized,
     /// The filter's innovation gate refused it (state unchanged).
     Gated {
@@ -89,6 +90,11 @@ pub struct Fuser {
     updates: u64,
     /// Time of the last (re)initialisation while no estimate has been fused since.
     fresh_init_t: Option<f64>,
+    /// The state is an acquisition's pose, no registration yet: the next
+    /// `tracking` estimate restarts the filter at its own pose instead of
+    /// updating it, as the tracker's local filter does
+    /// (`Tracker::initialize`, docs/design/acquisition-seed.md).
+    seeded: bool,
     init_from_tracking: bool,
 }
 
@@ -111,6 +117,7 @@ impl Fuser {
             max_disagreement_m: config.max_disagreement_m,
             updates: 0,
             fresh_init_t: None,
+            seeded: false,
             init_from_tracking: config.init_from_tracking,
         })
     }
@@ -145,6 +152,7 @@ impl Fuser {
         self.filter.initialize(t, &pose, v, w)?;
         self.selector.reset();
         self.fresh_init_t = Some(t);
+        self.seeded = true;
         self.updates += 1;
         Ok(true)
     }
@@ -159,6 +167,7 @@ impl Fuser {
         };
         self.filter.restore(&p)?;
         self.fresh_init_t = None;
+        self.seeded = false;
         self.updates = self.updates.max(s.sequence) + 1;
         Ok(true)
     }
@@ -236,6 +245,15 @@ impl Fuser {
             .collect()
     }
 
+    /// Restarts the filter at a registration's pose and time, zero rates.
+    fn restart_at(&mut self, m: &Measurement) -> Result<(), FilterError> {
+        let (v, w) = zero_rates();
+        self.filter.initialize(m.t, &m.t_sensor_target, v, w)?;
+        self.seeded = false;
+        self.updates += 1;
+        Ok(())
+    }
+
     /// Checks and fuses the estimate chosen for a frame. Errors on a filter
     /// failure (the state is then unchanged).
     fn fuse(&mut self, m: &Measurement) -> Result<EstimateOutcome, FilterError> {
@@ -257,15 +275,20 @@ impl Fuser {
             // The acquisition's own frame (or one before it) tracked by the
             // tracker: a registration beats the acquisition's pose.
             if self.fresh_init_t.is_some() {
-                let (v, w) = zero_rates();
-                self.filter.initialize(m.t, &m.t_sensor_target, v, w)?;
+                self.restart_at(m)?;
                 self.fresh_init_t = Some(m.t);
-                self.updates += 1;
                 return Ok(EstimateOutcome::Reinitialized);
             }
             return Ok(EstimateOutcome::TooOld {
                 dt_s: m.t - t_filter,
             });
+        }
+        if self.seeded {
+            // The first registration after an acquisition: the rate is
+            // learned from registrations only.
+            self.restart_at(m)?;
+            self.fresh_init_t = None;
+            return Ok(EstimateOutcome::Reinitialized);
         }
         let outcome = self.filter.update(m.t, &m.t_sensor_target, m.covariance)?;
         if !outcome.fused {

@@ -278,13 +278,13 @@ impl Track {
     /// registration was not good), with zero rates and the initial
     /// uncertainty, as the filter service does with the same estimate.
     fn restart_after(&mut self, out: &TrackOutput, given: &Pose) -> Result<(), TrackError> {
-        let pose = if out.status == TrackStatus::Tracking {
-            &out.t_sensor_target
-        } else {
-            given
-        };
+        if out.status == TrackStatus::Tracking {
+            return self
+                .tracker
+                .initialize_from_registration(out.t, &out.t_sensor_target);
+        }
         let (v, w) = zero_rates();
-        self.tracker.initialize(out.t, pose, v, w)
+        self.tracker.initialize(out.t, given, v, w)
     }
 
     /// Puts the filter prediction at `t` into the (lost) estimate of

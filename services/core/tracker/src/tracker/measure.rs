@@ -1,7 +1,8 @@
 //! One frame's measurement: the frame path, the mode's registration and,
 //! when CT-NDT stalled, its fallback; or why there is none.
 
-use super::{Tracker, ms, scan_rate};
+use super::Tracker;
+use super::scan::{ms, scan_rate};
 use crate::assess::stalled;
 use crate::dispatch::{Fitted, LastPose};
 use crate::mode::TrackingMode;

@@ -23,6 +23,9 @@ use spacepose_registration::{Registration, ScanTimes};
 use std::time::Instant;
 
 mod measure;
+mod scan;
+
+use scan::{check_scan_times, ms, scan_rate};
 
 /// Follows the target frame after frame. Not thread-safe by design: one
 /// tracker per stream of frames.
@@ -46,6 +49,10 @@ pub struct Tracker {
     /// The recent attitude innovations the limit follows
     /// (`crate::innovation`); reset at each (re)initialisation.
     innovations: InnovationHistory,
+    /// The filter holds only an initialisation (an acquisition, a command,
+    /// the truth): no registration has reached it since. The next one
+    /// restarts it instead of updating it (see [`Tracker::initialize`]).
+    seeded: bool,
 }
 
 impl Tracker {
@@ -73,6 +80,7 @@ impl Tracker {
             held,
             scan_w_target: None,
             innovations: InnovationHistory::default(),
+            seeded: false,
         })
     }
 
@@ -114,13 +122,23 @@ impl Tracker {
         if self.last.is_none() || self.filter.time().is_some_and(|t| state.t < t) {
             return Ok(());
         }
+        // A state newer than the local filter's fused a registration there.
+        let newer = self.filter.time().is_some_and(|t| state.t > t);
         self.filter.restore(state)?;
+        self.seeded &= !newer;
         Ok(())
     }
 
     /// (Re)starts tracking from `t_sensor_target` at time `t` (truth before
     /// acquisition exists, an acquisition result afterwards). Unknown rates
     /// are passed as zeros: the filter starts at ω = 0 (seed 000 §5.2).
+    ///
+    /// The pose is a seed, not a measurement of the motion: the first
+    /// registration the checks accept restarts the filter at its own pose
+    /// (ω = 0, the initial uncertainty) instead of updating it, so the
+    /// rate is learned from registrations only. An acquisition may be up
+    /// to 10° off and still be correct; fused, its error becomes a rate
+    /// the filter then believes (docs/design/acquisition-seed.md).
     pub fn initialize(
         &mut self,
         t: f64,
@@ -140,6 +158,20 @@ impl Tracker {
         self.held.reset();
         self.scan_w_target = None;
         self.innovations.reset();
+        self.seeded = true;
+        Ok(())
+    }
+
+    /// [`Self::initialize`] at a pose the tracker registered itself (the
+    /// acquisition's own frame, refined): the filter's next registration
+    /// updates it.
+    pub fn initialize_from_registration(
+        &mut self,
+        t: f64,
+        t_sensor_target: &Pose,
+    ) -> Result<(), TrackError> {
+        self.initialize(t, t_sensor_target, Vector3::zeros(), Vector3::zeros())?;
+        self.seeded = false;
         Ok(())
     }
 
@@ -288,7 +320,11 @@ impl Tracker {
             innovation_rot_deg,
             innovation_pos_m,
         ));
-        if reasons.is_empty() {
+        if reasons.is_empty() && self.seeded {
+            self.filter
+                .initialize(t, &measured, Vector3::zeros(), Vector3::zeros())?;
+            self.seeded = false;
+        } else if reasons.is_empty() {
             let outcome = self.filter.update(t, &measured, fused)?;
             if !outcome.fused {
                 reasons.push(format!(
@@ -358,36 +394,5 @@ impl Tracker {
     ) -> TrackOutput {
         self.lost = true;
         TrackOutput::lost(prediction, points_in, &reason, started)
-    }
-}
-
-/// The angular velocity (target frame, rad/s) over a scan fitted with two
-/// poses: `Log(R_sᵀ R_e) / Δt` of `t_sensor_target` at its start and end.
-pub(crate) fn scan_rate(
-    t_target_sensor_start: Option<&Pose>,
-    registration: &Registration,
-    scan: &ScanTimes,
-) -> Option<Vector3<f64>> {
-    let start = t_target_sensor_start?.inverse();
-    let end = registration.t_sensor_target();
-    let dt = scan.end_s - scan.start_s;
-    (dt > 0.0).then(|| so3::log(&(start.rotation.inverse() * end.rotation)) / dt)
-}
-
-pub(crate) fn ms(since: Instant) -> f64 {
-    since.elapsed().as_secs_f64() * 1e3
-}
-
-/// Rejects non-finite or reversed scan times, and a scan that does not end
-/// after the previous one (`previous_end_s`).
-fn check_scan_times(start_s: f64, end_s: f64, previous_end_s: f64) -> Result<(), TrackError> {
-    if start_s.is_finite() && end_s.is_finite() && start_s <= end_s && end_s > previous_end_s {
-        Ok(())
-    } else {
-        Err(TrackError::InvalidScanTimes {
-            start_s,
-            end_s,
-            previous_end_s: Some(previous_end_s),
-        })
     }
 }
