@@ -16,6 +16,7 @@
 //! The frame's truth is the jittered pose at the scan end: what an
 //! estimator should report.
 
+use crate::error::SimError;
 use nalgebra::{Rotation3, Vector3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -55,25 +56,50 @@ impl Default for Mismatch {
 }
 
 impl Mismatch {
-    /// Fails on a negative, non-finite or inverted value.
-    pub fn validate(&self) -> Result<(), String> {
-        self.as_built.validate().map_err(|e| e.to_string())?;
+    /// Fails on a negative, non-finite or inverted value
+    /// ([`SimError::InvalidConfig`] naming the field), or an invalid
+    /// as-built target ([`SimError::Mismatch`]).
+    pub fn validate(&self) -> Result<(), SimError> {
+        self.as_built
+            .validate()
+            .map_err(|e| SimError::Mismatch(e.to_string()))?;
         let [lo, hi] = self.jitter_hz;
-        let ok = self.jitter_deg.is_finite()
-            && self.jitter_deg >= 0.0
-            && lo.is_finite()
-            && hi.is_finite()
-            && 0.0 < lo
-            && lo <= hi
-            && self.acceleration_mps2.is_finite()
-            && self.acceleration_mps2 >= 0.0;
-        if ok {
-            Ok(())
-        } else {
-            Err(format!(
-                "mismatch: jitter_deg >= 0, 0 < jitter_hz[0] <= jitter_hz[1], acceleration_mps2 >= 0, all finite: {self:?}"
-            ))
+        let checks = [
+            (
+                "mismatch.jitter_deg",
+                self.jitter_deg,
+                self.jitter_deg >= 0.0,
+                "must be finite and >= 0",
+            ),
+            (
+                "mismatch.jitter_hz[0]",
+                lo,
+                lo > 0.0,
+                "must be finite and > 0",
+            ),
+            (
+                "mismatch.jitter_hz[1]",
+                hi,
+                hi >= lo,
+                "must be finite and >= jitter_hz[0]",
+            ),
+            (
+                "mismatch.acceleration_mps2",
+                self.acceleration_mps2,
+                self.acceleration_mps2 >= 0.0,
+                "must be finite and >= 0",
+            ),
+        ];
+        for (field, value, ok, reason) in checks {
+            if !(value.is_finite() && ok) {
+                return Err(SimError::InvalidConfig {
+                    field,
+                    value,
+                    reason,
+                });
+            }
         }
+        Ok(())
     }
 
     /// The jitter of a run seeded with `seed`.

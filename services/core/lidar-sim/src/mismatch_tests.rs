@@ -83,7 +83,11 @@ fn bad_settings_are_refused() {
             ..Mismatch::default()
         },
     ] {
-        assert!(bad.validate().is_err());
+        let e = bad.validate();
+        assert!(
+            matches!(&e, Err(SimError::InvalidConfig { field, .. }) if field.starts_with("mismatch.")),
+            "{e:?}"
+        );
     }
     assert!(Mismatch::default().validate().is_ok());
 }

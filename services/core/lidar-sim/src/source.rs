@@ -61,7 +61,7 @@ impl FrameSource {
         seed: u64,
         mismatch: Mismatch,
     ) -> Result<Self, SimError> {
-        mismatch.validate().map_err(SimError::Mismatch)?;
+        mismatch.validate()?;
         let as_built = mismatch
             .as_built
             .apply(nominal, seed)
