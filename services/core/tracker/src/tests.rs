@@ -151,3 +151,45 @@ fn a_jump_the_track_has_never_made_is_doubted_below_the_absolute_limit() {
         assert_eq!(out.reason.contains("filter gate"), gate.is_some());
     }
 }
+
+/// An initialisation is a seed (docs/design/acquisition-seed.md): the first
+/// registration the checks accept restarts the filter at its own pose with
+/// zero rates, whatever the seed's error; the next ones update it.
+#[test]
+fn the_first_registration_after_a_seed_restarts_the_filter() {
+    let (target, model) = fixture();
+    let mut config = TrackerConfig::with_mode(TrackingMode::Ndt);
+    config.loss.innovation.enabled = false;
+    config.filter.gate_mahalanobis2 = None;
+    let mut tracker = Tracker::new(config, model.clone()).unwrap();
+    // 4° off about an axis across the spin: a near miss.
+    let off = so3::exp(&Vector3::new(4f64.to_radians(), 0.0, 0.0));
+    let mut seed = truth(0.0, 3.0);
+    seed.rotation = off * seed.rotation;
+    tracker
+        .initialize(0.0, &seed, Vector3::zeros(), Vector3::zeros())
+        .unwrap();
+    let first = tracker
+        .process(&target.frame(&truth(1.0, 3.0), 0.02), 0.9, 1.0)
+        .unwrap();
+    assert_eq!(first.status, TrackStatus::Tracking, "{}", first.reason);
+    let measured = first.registration.as_ref().unwrap().t_sensor_target();
+    let state = tracker.predict_at(1.0).unwrap();
+    let (angle, dist) = state.pose.error_to(&measured);
+    assert!(angle < 1e-9 && dist < 1e-9, "restarted at the registration");
+    assert_eq!(state.w_target, Vector3::zeros(), "no rate from the seed");
+    let second = tracker
+        .process(&target.frame(&truth(2.0, 3.0), 0.02), 1.9, 2.0)
+        .unwrap();
+    assert_eq!(second.status, TrackStatus::Tracking, "{}", second.reason);
+    let w_degps = tracker
+        .predict_at(2.0)
+        .unwrap()
+        .w_target
+        .norm()
+        .to_degrees();
+    assert!(
+        w_degps > 0.5,
+        "the second registration updates: {w_degps}°/s"
+    );
+}
