@@ -117,7 +117,7 @@ impl ServiceConfig for LidarSimConfig {
             look.validate().map_err(|e| e.to_string())?;
         }
         if let Some(m) = &self.mismatch {
-            m.validate()?;
+            m.validate().map_err(|e| e.to_string())?;
         }
         if !(self.range_scale.is_finite() && self.range_scale >= 1.0) {
             return Err(format!(
