@@ -64,7 +64,7 @@ impl Node for InitNode {
         let header = *cloud.header;
         ctx.counters.frames_in += 1;
         ctx.counters.last_frame = header.sequence;
-        self.machine.on_frame(header.sequence);
+        log_event(self.machine.on_frame(header.sequence));
         // The held frame's buffer is reused when it was not used.
         let mut points = self.held.take().map(|f| f.points).unwrap_or_default();
         points.clear();
@@ -183,6 +183,7 @@ impl InitNode {
 fn log_event(event: Event) {
     match event {
         Event::None => {}
+        Event::NoTrack { frame } => info!(frame, "no tracker tracks: acquiring"),
         Event::LossDetected { frame } => info!(frame, "track lost: acquiring"),
         Event::HandoverFailed { frame } => {
             warn!(

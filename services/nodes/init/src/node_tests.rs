@@ -175,7 +175,9 @@ fn acquires_at_start_and_again_after_a_loss_or_a_failed_handover() {
     // points counted.
     let mut points = frame.points.clone();
     points.extend([Point::new(f32::NAN, 0.0, 15.0, 1.0, 0.0); 2]);
-    assert!(h.cloud(0, &points).is_empty(), "acquired on the worker");
+    assert!(h.cloud(0, &points).is_empty());
+    assert!(!h.node.busy(), "no tracker has said it does not track");
+    h.estimate(tracker(0, WireStatus::Lost, NOW_NS));
     assert_acquired(&h.finished(), 0, &frame);
     assert_eq!(h.node.next_wake_ns(), None);
     assert!(matches!(
@@ -236,6 +238,7 @@ fn empty_and_sparse_frames_fail_and_the_retry_waits_for_a_later_frame() {
     assert_eq!(h.counters.rejected_wire, 1);
 
     assert!(h.cloud(0, &[]).is_empty());
+    h.estimate(tracker(0, WireStatus::Lost, NOW_NS));
     let r = h.finished();
     assert_eq!((r.sequence, r.success), (0, 0));
     assert!(r.f_conv_m2.is_nan());
@@ -305,6 +308,7 @@ fn a_panic_on_the_acquisition_thread_is_raised_by_the_node() {
     let mut h = Harness::new(node.unwrap());
     let points = vec![Point::new(0.0, 0.0, 15.0, 1.0, 0.0); 5];
     assert!(h.cloud(0, &points).is_empty());
+    h.estimate(tracker(0, WireStatus::Lost, NOW_NS));
     let polled = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         for _ in 0..30_000 {
             h.wake(|_, _| {});
@@ -345,4 +349,31 @@ fn on_a_local_bus_init_reads_the_cropped_clouds_and_the_estimates() {
         std::thread::sleep(Duration::from_millis(2));
     }
     panic!("no acquisition result within 60 s");
+}
+
+/// Restarted while the suite tracks: the first cloud comes before any
+/// estimate (a tracker's estimate of a frame follows its cloud), and init
+/// waits for the estimate, which says the suite tracks: no acquisition.
+/// With no tracker answering at all, it acquires after
+/// `instance_timeout_frames` frames.
+#[test]
+fn a_restarted_init_does_not_acquire_while_the_suite_tracks() {
+    let frame = deos_frame();
+    let mut h = Harness::new(InitNode::new(InitServiceConfig::default(), &info("init")).unwrap());
+    assert!(h.cloud(40, &frame.points).is_empty());
+    assert!(!h.node.busy(), "acquired before hearing the trackers");
+    h.estimate(tracker(40, WireStatus::Tracking, NOW_NS));
+    assert_eq!(h.node.phase(), Phase::Tracking);
+    assert!(h.cloud(41, &frame.points).is_empty());
+    assert!(!h.node.busy());
+    assert_eq!(h.node.stats().attempts, 0);
+
+    let mut h = Harness::new(InitNode::new(InitServiceConfig::default(), &info("init")).unwrap());
+    let timeout = InitConfig::default().instance_timeout_frames;
+    for k in 0..timeout {
+        assert!(h.cloud(k, &[]).is_empty());
+        assert!(!h.node.busy(), "frame {k}");
+    }
+    assert!(h.cloud(timeout, &[]).is_empty());
+    assert_eq!(h.finished().sequence, timeout);
 }

@@ -4,6 +4,10 @@
 //! ```text
 //!             start
 //!               │
+//!               ▼
+//!           Listening ── an estimate: tracking ──▶ Tracking
+//!               │ an estimate: lost, or no estimate in
+//!               │ instance_timeout_frames frames
 //!               ▼         rejected (f_CONV > f_MAX, too few points):
 //!   ┌──▶ Acquiring{not_before} ◀──┐  retry on frame + retry_after_frames
 //!   │           │ accepted        │
@@ -18,6 +22,15 @@
 //! A frame is lost when no active tracker instance tracks it (redundant
 //! trackers: one lost instance beside a tracking one is not a loss). An
 //! acquisition never uses a frame older than the loss that triggered it.
+//!
+//! The service starts by listening: it acquires only once a tracker says
+//! it does not track (an uninitialised tracker reports `lost` on every
+//! frame), or when no tracker has answered for `instance_timeout_frames`
+//! frames. A tracker's estimate of frame k follows ingest's cloud of
+//! frame k, so a service (re)started while the suite tracks would
+//! otherwise hold a cloud before it heard any estimate, acquire on it, and
+//! restart a good track from its acquisition (the chaos test's `kill:init`
+//! did exactly that when the restarted service came up).
 
 use crate::error::InitError;
 use serde::{Deserialize, Serialize};
@@ -85,6 +98,10 @@ pub struct EstimateInfo {
 /// Where the service stands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Phase {
+    /// Just started: whether the suite tracks is not known yet. The first
+    /// tracker estimate decides; with none by the frame
+    /// `instance_timeout_frames` after the first one seen, acquire.
+    Listening,
     /// A pose is needed: acquire from the next frame numbered `not_before`
     /// or later.
     Acquiring {
@@ -108,6 +125,12 @@ pub enum Phase {
 pub enum Event {
     /// Nothing changed.
     None,
+    /// At start, a tracker reported no track (or none answered): acquire
+    /// from `frame` on.
+    NoTrack {
+        /// The first frame to acquire on.
+        frame: u64,
+    },
     /// The tracker tracks (after a hand-over, or on its own).
     TrackerTracking {
         /// The frame it reported.
@@ -167,12 +190,12 @@ pub struct InitStateMachine {
 }
 
 impl InitStateMachine {
-    /// Starts in `Acquiring { not_before: 0 }`: acquire at start.
+    /// Starts in `Listening`: acquire once a tracker reports no track.
     pub fn new(config: InitConfig) -> Result<Self, InitError> {
         config.validate()?;
         Ok(Self {
             config,
-            phase: Phase::Acquiring { not_before: 0 },
+            phase: Phase::Listening,
             instances: HashMap::new(),
             need_since: None,
             stats: InitStats::default(),
@@ -194,11 +217,22 @@ impl InitStateMachine {
         matches!(self.phase, Phase::Acquiring { not_before } if frame >= not_before)
     }
 
-    /// Notes that a frame arrived (the start of the first need for a pose).
-    pub fn on_frame(&mut self, frame: u64) {
-        if self.need_since.is_none() && matches!(self.phase, Phase::Acquiring { .. }) {
+    /// Notes that a frame arrived (the start of the first need for a
+    /// pose). While listening with no tracker heard for
+    /// `instance_timeout_frames` frames, the service acquires.
+    pub fn on_frame(&mut self, frame: u64) -> Event {
+        let waiting = matches!(self.phase, Phase::Acquiring { .. } | Phase::Listening);
+        if self.need_since.is_none() && waiting {
             self.need_since = Some(frame);
         }
+        let silent = self
+            .need_since
+            .is_some_and(|s| frame >= s + self.config.instance_timeout_frames);
+        if self.phase == Phase::Listening && silent {
+            self.phase = Phase::Acquiring { not_before: frame };
+            return Event::NoTrack { frame };
+        }
+        Event::None
     }
 
     /// A tracker estimate.
@@ -207,6 +241,15 @@ impl InitStateMachine {
         let frame = e.sequence;
         let tracked = self.suite_tracks(frame);
         match self.phase {
+            Phase::Listening if tracked => {
+                self.phase = Phase::Tracking;
+                self.need_since = None;
+                Event::TrackerTracking { frame }
+            }
+            Phase::Listening => {
+                self.phase = Phase::Acquiring { not_before: frame };
+                Event::NoTrack { frame }
+            }
             Phase::Tracking if !tracked => {
                 self.stats.losses += 1;
                 self.need(frame);

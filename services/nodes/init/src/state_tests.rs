@@ -20,9 +20,14 @@ fn tracker(sequence: u64, status: WireStatus) -> EstimateInfo {
 #[test]
 fn acquires_at_start_and_hands_over_to_the_tracker() {
     let mut s = sm();
+    assert!(!s.wants(0), "nothing heard from the trackers yet");
+    assert_eq!(s.on_frame(0), Event::None);
+    // The uninitialised tracker reports lost: acquire from that frame.
+    assert_eq!(
+        s.on_estimate(&tracker(0, WireStatus::Lost)),
+        Event::NoTrack { frame: 0 }
+    );
     assert!(s.wants(0));
-    s.on_frame(0);
-    // The uninitialised tracker reports lost: still acquiring.
     assert_eq!(s.on_estimate(&tracker(0, WireStatus::Lost)), Event::None);
     assert_eq!(
         s.on_acquisition(0, true, Some(100)),
@@ -114,8 +119,11 @@ fn a_handover_fails_when_the_tracker_loses_the_given_pose() {
 
 #[test]
 fn a_tracker_that_tracks_on_its_own_ends_the_acquisition() {
-    // E.g. the init service restarted while the suite was tracking.
+    // E.g. the init service restarted while the suite was tracking: the
+    // cloud of frame 40 comes first, then the estimate that says so.
     let mut s = sm();
+    assert_eq!(s.on_frame(40), Event::None);
+    assert!(!s.wants(40));
     assert_eq!(
         s.on_estimate(&tracker(40, WireStatus::Tracking)),
         Event::TrackerTracking { frame: 40 }
@@ -166,4 +174,23 @@ fn zero_counts_are_errors() {
     ] {
         assert!(InitStateMachine::new(c).is_err());
     }
+}
+
+#[test]
+fn with_no_tracker_answering_init_acquires_after_the_instance_timeout() {
+    let mut s = sm();
+    for k in 10..13 {
+        assert_eq!(s.on_frame(k), Event::None);
+        assert!(!s.wants(k));
+    }
+    assert_eq!(s.on_frame(13), Event::NoTrack { frame: 13 });
+    assert!(s.wants(13) && !s.wants(12));
+    assert_eq!(
+        s.on_acquisition(13, true, None),
+        Event::Accepted {
+            frame: 13,
+            delay_frames: Some(3)
+        }
+    );
+    assert_eq!(s.stats().losses, 0);
 }

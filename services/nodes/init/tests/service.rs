@@ -7,7 +7,7 @@ use spacepose_cnn::{DatasetConfig, Generator};
 use spacepose_geometry::Point;
 use spacepose_messages::{
     AcquisitionMethod, AcquisitionResult, CloudHeader, Health, MAX_POINTS, Names, PoseEstimate,
-    ServiceState,
+    ServiceState, WireStatus,
 };
 use spacepose_model::Target;
 use spacepose_runtime::testing::{self, ChildGuard};
@@ -121,6 +121,12 @@ fn init_acquires_at_start_counts_and_stops_cleanly() {
     let mut points = frame.points.clone();
     points.push(Point::new(f32::NAN, 0.0, 15.0, 1.0, 0.0));
     clouds.send(CloudHeader::new(7, 7.0, 7.5), &points).unwrap();
+    // The (uninitialised) tracker says it does not track: acquire. Until a
+    // tracker answers, init only listens.
+    let mut lost = PoseEstimate::new();
+    lost.sequence = 7;
+    lost.status = WireStatus::Lost as u8;
+    poses.send(&lost).unwrap();
     let r = wait_for("the acquisition result", || results.try_recv().unwrap());
     assert_eq!((r.sequence, r.t_s, r.success), (7, 7.5, 1));
     assert_eq!(r.method, AcquisitionMethod::Cnn as u8);
