@@ -10,6 +10,7 @@ fn frame(frame: usize, status: TrackStatus, ang: f64, pos_cm: f64) -> FrameRecor
         p_sensor_target_m: [0.0; 3],
         ang_err_deg: ang,
         pos_err_cm: pos_cm,
+        err_rotvec_target_deg: [0.0; 3],
         w_err_deg_s: 0.0,
         w_err_along_deg_s: 0.0,
         time_ms: 1.0,

@@ -34,6 +34,11 @@ pub struct FrameRecord {
     pub ang_err_deg: f64,
     /// Position error (cm); NaN when lost.
     pub pos_err_cm: f64,
+    /// The attitude error as a rotation vector in the target frame,
+    /// `Log(Qᵀ R)` against the truth `Q` (its symmetric variant nearest the
+    /// estimate `R`), in degrees: its direction tells a twin lock (deos:
+    /// about body x, 60°) from a slide. NaN when lost.
+    pub err_rotvec_target_deg: [f64; 3],
     /// Error of the filter's angular velocity after this frame, `|ω̂ − ω|`
     /// in the target frame (deg/s).
     pub w_err_deg_s: f64,
@@ -246,6 +251,10 @@ pub fn record(
         let (a, d) = pose_error(&p, &truth.t_sensor_target, symmetries);
         (a, d * 100.0)
     });
+    let err_rotvec_target_deg = pose.map_or([f64::NAN; 3], |p: Pose| {
+        let v = super::bounds::error_rotvec(&p, &truth.t_sensor_target, symmetries);
+        [v.x.to_degrees(), v.y.to_degrees(), v.z.to_degrees()]
+    });
     let nees = pose
         .and_then(|p| {
             super::nees::pose_nees(&p, &estimate.covariance, &truth.t_sensor_target, symmetries)
@@ -264,6 +273,7 @@ pub fn record(
         p_sensor_target_m: estimate.p_sensor_target,
         ang_err_deg: ang,
         pos_err_cm: pos,
+        err_rotvec_target_deg,
         w_err_deg_s: w_err.norm().to_degrees(),
         w_err_along_deg_s: w_err.dot(&along).to_degrees(),
         time_ms: out.map_or(f64::NAN, |o| o.timings.total_ms),
