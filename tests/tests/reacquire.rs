@@ -275,6 +275,11 @@ fn sparse_and_all_outlier_clouds_give_failure_results() {
         .subscriber::<AcquisitionResult>(&names.acquisition())
         .unwrap();
     let clouds = bus.cloud_publisher(&names.cloud(), MAX_POINTS).unwrap();
+    // The uninitialised tracker's `lost` estimates: init acquires once a
+    // tracker says it does not track.
+    let poses = bus
+        .publisher::<spacepose_messages::PoseEstimate>(&names.pose())
+        .unwrap();
     let health = bus
         .subscriber::<spacepose_messages::Health>(&names.health())
         .unwrap();
@@ -319,6 +324,10 @@ fn sparse_and_all_outlier_clouds_give_failure_results() {
                 &cloud,
             )
             .unwrap();
+        let mut lost = spacepose_messages::PoseEstimate::new();
+        lost.sequence = seq;
+        lost.status = spacepose_messages::WireStatus::Lost as u8;
+        poses.send(&lost).unwrap();
         let deadline = Instant::now() + Duration::from_secs(60);
         let r = loop {
             if let Some(r) = results.try_recv().unwrap() {

@@ -7,11 +7,13 @@ use crate::error::InitError;
 use crate::method::PoseAcquirer;
 use crate::state::InitConfig;
 use crate::template::TemplateMatching;
+use crate::verify::{Verifier, VerifyConfig};
 use serde::{Deserialize, Serialize};
 use spacepose_acquisition::TemplateMatchingConfig;
 use spacepose_cnn::model_meta::ModelMeta;
 use spacepose_lidar_sim::SensorConfig;
 use spacepose_messages::Name;
+use spacepose_model::Target;
 use spacepose_model::package::TargetPackage;
 use spacepose_runtime::ServiceConfig;
 use std::path::{Path, PathBuf};
@@ -57,6 +59,9 @@ pub struct InitServiceConfig {
     pub template_matching: TemplateMatchingConfig,
     /// The CNN: model directory, engine, f_MAX, refinement.
     pub cnn: CnnMethodConfig,
+    /// While the suite tracks: acquisitions on later frames against the
+    /// tracker's poses (`crate::verify`).
+    pub verify: VerifyConfig,
 }
 
 impl Default for InitServiceConfig {
@@ -72,6 +77,7 @@ impl Default for InitServiceConfig {
             state: InitConfig::default(),
             template_matching: TemplateMatchingConfig::default(),
             cnn: CnnMethodConfig::default(),
+            verify: VerifyConfig::default(),
         }
     }
 }
@@ -108,6 +114,9 @@ impl InitServiceConfig {
             return bad(format!("min_points = {} must be >= 3", self.min_points));
         }
         self.state.validate()?;
+        self.verify
+            .validate()
+            .map_err(|e| InitError::InvalidConfig(format!("verify: {e}")))?;
         self.template_matching
             .validate()
             .map_err(|e| InitError::InvalidConfig(format!("template_matching: {e}")))
@@ -123,9 +132,29 @@ impl InitServiceConfig {
 
     /// Resolves the target and builds every configured method, in order.
     pub fn build_chain(&self) -> Result<MethodChain, InitError> {
+        self.build().map(|(chain, _)| chain)
+    }
+
+    /// Resolves the target once; builds the method chain and the verifier
+    /// of the hand-overs (the target's symmetries and size).
+    pub fn build(&self) -> Result<(MethodChain, Verifier), InitError> {
         let package = spacepose_prepare::resolve(&self.target, self.target_scale)
             .map_err(|e| InitError::InvalidConfig(format!("target {:?}: {e}", self.target)))?;
         let target = Arc::new(package.target.clone());
+        let verifier = Verifier::new(
+            self.verify.clone(),
+            target.symmetries().to_vec(),
+            target.bounding_radius(),
+        );
+        Ok((self.build_methods(&package, target)?, verifier))
+    }
+
+    /// Every configured method, in order, on the resolved `target`.
+    fn build_methods(
+        &self,
+        package: &TargetPackage,
+        target: Arc<Target>,
+    ) -> Result<MethodChain, InitError> {
         let mut methods: Vec<Box<dyn PoseAcquirer>> = Vec::new();
         for kind in &self.methods {
             match kind {
@@ -134,7 +163,7 @@ impl InitServiceConfig {
                     self.sensor(),
                     self.template_matching.clone(),
                 )?)),
-                MethodKind::Cnn => match self.cnn_model_dir(&package) {
+                MethodKind::Cnn => match self.cnn_model_dir(package) {
                     Ok(dir) => {
                         tracing::info!(target = target.name(), "CNN model from {}", dir.display());
                         methods.push(Box::new(CnnMethod::new(target.clone(), &dir, &self.cnn)?));

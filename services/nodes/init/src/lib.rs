@@ -13,6 +13,9 @@
 //!   succeeded: the CNN ([`cnn_method::CnnMethod`], issue 6) first, with
 //!   template matching ([`template::TemplateMatching`]) as the fallback.
 //! - [`config::InitServiceConfig`]: the TOML file, and the chain it builds.
+//! - [`verify::Verifier`]: while the suite tracks, acquisitions on later
+//!   frames against the tracker's poses; contradictions that agree with
+//!   each other replace the track.
 //! - [`wire`]: estimates in, results out.
 #![forbid(unsafe_code)]
 
@@ -24,6 +27,7 @@ pub mod method;
 pub mod node;
 pub mod state;
 pub mod template;
+pub mod verify;
 pub mod wire;
 pub mod worker;
 
@@ -35,3 +39,4 @@ pub use method::{Attempt, MethodOutput, PoseAcquirer};
 pub use node::InitNode;
 pub use state::{EstimateInfo, Event, InitConfig, InitStateMachine, InitStats, Phase};
 pub use template::TemplateMatching;
+pub use verify::{Verdict, Verifier, VerifyConfig};

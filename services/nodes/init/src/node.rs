@@ -7,12 +7,22 @@
 //! wake-up's [`Node::poll`] publishes a finished acquisition and starts
 //! the next wanted one; while one runs the node asks to be woken every
 //! [`BUSY_POLL_NS`].
+//!
+//! While the suite tracks a pose a fallback method acquired and no
+//! acquisition is wanted, the worker verifies the track
+//! ([`crate::verify`]): it acquires on a copy of the held frame, and the
+//! result is compared with the tracker's pose of that frame instead of
+//! being published; a track that a more trusted method contradicts is
+//! replaced by publishing the newest contradicting pose as an acquisition.
 
 use crate::chain::MethodChain;
 use crate::config::InitServiceConfig;
 use crate::state::{EstimateInfo, Event, InitConfig, InitStateMachine, InitStats, Phase};
+use crate::verify::{TrackedPose, Verdict, Verifier};
 use crate::worker::{Done, Frame, Worker};
-use spacepose_messages::{Cloud, Message, Name, ServiceKind, realtime_ns};
+use spacepose_messages::{
+    AcquisitionMethod, Cloud, Message, Name, PoseEstimate, ServiceKind, WireStatus, realtime_ns,
+};
 use spacepose_runtime::{Ctx, Flow, Node, NodeInfo};
 use std::time::Instant;
 use tracing::{info, warn};
@@ -28,6 +38,14 @@ pub struct InitNode {
     instance: Name,
     held: Option<Frame>,
     wake_ns: Option<i64>,
+    verifier: Option<Verifier>,
+    /// The chain's methods, most trusted first.
+    methods: Vec<AcquisitionMethod>,
+    /// The frame the worker verifies (None: it acquires, or is idle).
+    verifying: Option<u64>,
+    /// When the last accepted result went out (CLOCK_REALTIME ns): the
+    /// tracker's estimates started before it are of the previous track.
+    handed_over_ns: Option<i64>,
 }
 
 impl Node for InitNode {
@@ -36,7 +54,7 @@ impl Node for InitNode {
 
     fn new(config: InitServiceConfig, info: &NodeInfo) -> anyhow::Result<Self> {
         let started = Instant::now();
-        let chain = config.build_chain()?;
+        let (chain, verifier) = config.build()?;
         let methods: Vec<&str> = chain.methods().iter().map(|m| m.as_str()).collect();
         info!(
             target = config.target,
@@ -44,7 +62,7 @@ impl Node for InitNode {
             ms = started.elapsed().as_millis() as u64,
             "acquisition methods ready"
         );
-        InitNode::with_chain(chain, config.state, info.instance)
+        Ok(InitNode::with_chain(chain, config.state, info.instance)?.with_verifier(verifier))
     }
 
     fn on_message(&mut self, msg: &Message, ctx: &mut Ctx<'_>) {
@@ -52,7 +70,10 @@ impl Node for InitNode {
             return;
         };
         match EstimateInfo::from_wire(estimate) {
-            Ok(e) => log_event(self.machine.on_estimate(&e)),
+            Ok(e) => {
+                log_event(self.machine.on_estimate(&e));
+                self.note_tracked(&e, estimate);
+            }
             Err(err) => {
                 ctx.counters.rejected_wire += 1;
                 warn!("estimate refused: {err}");
@@ -78,7 +99,10 @@ impl Node for InitNode {
 
     fn poll(&mut self, ctx: &mut Ctx<'_>) -> Flow {
         if let Some(done) = self.worker.finished() {
-            self.publish(done, ctx);
+            match self.verifying.take() {
+                Some(_) => self.verified(done, ctx),
+                None => self.publish(done, ctx),
+            }
         }
         self.start_if_wanted();
         self.wake_ns = self.worker.busy().then(|| ctx.now_ns + BUSY_POLL_NS);
@@ -107,11 +131,21 @@ impl InitNode {
     ) -> anyhow::Result<Self> {
         Ok(InitNode {
             machine: InitStateMachine::new(state)?,
+            methods: chain.methods(),
             worker: Worker::spawn(chain)?,
             instance,
             held: None,
             wake_ns: None,
+            verifier: None,
+            verifying: None,
+            handed_over_ns: None,
         })
+    }
+
+    /// This node verifying its hand-overs with `verifier` (when enabled).
+    pub fn with_verifier(mut self, verifier: Verifier) -> Self {
+        self.verifier = verifier.enabled().then_some(verifier);
+        self
     }
 
     /// Where the service stands.
@@ -130,7 +164,8 @@ impl InitNode {
     }
 
     /// Hands the held frame to the worker when the state machine wants it
-    /// and no acquisition is running.
+    /// and no acquisition is running; else, while the suite tracks, a copy
+    /// of it when a verification is due.
     fn start_if_wanted(&mut self) {
         if self.worker.busy() {
             return;
@@ -141,6 +176,58 @@ impl InitNode {
             .is_some_and(|h| self.machine.wants(h.sequence));
         if let Some(frame) = self.held.take_if(|_| wanted) {
             self.worker.start(frame);
+            return;
+        }
+        let tracking = self.machine.phase() == Phase::Tracking;
+        let due = |h: &Frame| self.verifier.as_ref().is_some_and(|v| v.due(h.sequence));
+        if let Some(frame) = self.held.as_ref().filter(|h| tracking && due(h)) {
+            self.verifying = Some(frame.sequence);
+            self.worker.start(frame.clone());
+        }
+    }
+
+    /// Gives the verifier the tracker's `tracking` pose of a frame of the
+    /// current track (not one started before the last hand-over).
+    fn note_tracked(&mut self, e: &EstimateInfo, estimate: &PoseEstimate) {
+        let Some(verifier) = &mut self.verifier else {
+            return;
+        };
+        let before = matches!((e.started_ns, self.handed_over_ns), (Some(s), Some(h)) if s < h);
+        let tracking = e.status == WireStatus::Tracking && self.machine.phase() == Phase::Tracking;
+        if let (false, true, Ok(pose)) = (before, tracking, estimate.pose()) {
+            verifier.on_tracked(TrackedPose {
+                sequence: e.sequence,
+                t_sensor_target: pose,
+            });
+        }
+    }
+
+    /// A verification finished: compared with the track; a track the
+    /// verifications contradict is replaced by the newest pose found.
+    fn verified(&mut self, done: Done, ctx: &mut Ctx<'_>) {
+        let Some(verifier) = &mut self.verifier else {
+            return;
+        };
+        if self.machine.phase() != Phase::Tracking {
+            return;
+        }
+        let accepted = done.acquisition.accepted().and_then(|a| {
+            let rank = self.methods.iter().position(|m| *m == a.method)?;
+            Some((a.outcome.as_ref().ok()?.t_sensor_target, rank))
+        });
+        let verdict = verifier.on_result(done.sequence, accepted);
+        info!(
+            sequence = done.sequence,
+            ?verdict,
+            "verification: {}",
+            done.acquisition.summary()
+        );
+        if let Verdict::Replace { off_deg, .. } = verdict {
+            warn!(
+                sequence = done.sequence,
+                off_deg, "the verifications contradict the track: the newest pose replaces it"
+            );
+            self.publish(done, ctx);
         }
     }
 
@@ -173,6 +260,13 @@ impl InitNode {
             "acquisition: {}",
             acquisition.summary()
         );
+        if accepted {
+            self.handed_over_ns = published_ns;
+            let origin = self.methods.iter().position(|m| *m as u8 == msg.method);
+            if let Some(v) = &mut self.verifier {
+                v.reset(origin);
+            }
+        }
         log_event(
             self.machine
                 .on_acquisition(done.sequence, accepted, published_ns),
