@@ -41,11 +41,8 @@ pub struct InitNode {
     verifier: Option<Verifier>,
     /// The chain's methods, most trusted first.
     methods: Vec<AcquisitionMethod>,
-    /// The frame the worker verifies (None: it acquires, or is idle).
-    verifying: Option<u64>,
-    /// When the last accepted result went out (CLOCK_REALTIME ns): the
-    /// tracker's estimates started before it are of the previous track.
-    handed_over_ns: Option<i64>,
+    /// The worker verifies (it does not acquire).
+    verifying: bool,
 }
 
 impl Node for InitNode {
@@ -99,9 +96,10 @@ impl Node for InitNode {
 
     fn poll(&mut self, ctx: &mut Ctx<'_>) -> Flow {
         if let Some(done) = self.worker.finished() {
-            match self.verifying.take() {
-                Some(_) => self.verified(done, ctx),
-                None => self.publish(done, ctx),
+            if std::mem::take(&mut self.verifying) {
+                self.verified(done, ctx);
+            } else {
+                self.publish(done, ctx);
             }
         }
         self.start_if_wanted();
@@ -137,8 +135,7 @@ impl InitNode {
             held: None,
             wake_ns: None,
             verifier: None,
-            verifying: None,
-            handed_over_ns: None,
+            verifying: false,
         })
     }
 
@@ -181,7 +178,7 @@ impl InitNode {
         let tracking = self.machine.phase() == Phase::Tracking;
         let due = |h: &Frame| self.verifier.as_ref().is_some_and(|v| v.due(h.sequence));
         if let Some(frame) = self.held.as_ref().filter(|h| tracking && due(h)) {
-            self.verifying = Some(frame.sequence);
+            self.verifying = true;
             self.worker.start(frame.clone());
         }
     }
@@ -192,9 +189,9 @@ impl InitNode {
         let Some(verifier) = &mut self.verifier else {
             return;
         };
-        let before = matches!((e.started_ns, self.handed_over_ns), (Some(s), Some(h)) if s < h);
+        let current = self.machine.of_current_track(e);
         let tracking = e.status == WireStatus::Tracking && self.machine.phase() == Phase::Tracking;
-        if let (false, true, Ok(pose)) = (before, tracking, estimate.pose()) {
+        if let (true, true, Ok(pose)) = (current, tracking, estimate.pose()) {
             verifier.on_tracked(TrackedPose {
                 sequence: e.sequence,
                 t_sensor_target: pose,
@@ -211,9 +208,12 @@ impl InitNode {
         if self.machine.phase() != Phase::Tracking {
             return;
         }
+        let methods = &self.methods;
         let accepted = done.acquisition.accepted().and_then(|a| {
-            let rank = self.methods.iter().position(|m| *m == a.method)?;
-            Some((a.outcome.as_ref().ok()?.t_sensor_target, rank))
+            Some((
+                a.outcome.as_ref().ok()?.t_sensor_target,
+                rank(methods, a.method)?,
+            ))
         });
         let verdict = verifier.on_result(done.sequence, accepted);
         info!(
@@ -261,8 +261,9 @@ impl InitNode {
             acquisition.summary()
         );
         if accepted {
-            self.handed_over_ns = published_ns;
-            let origin = self.methods.iter().position(|m| *m as u8 == msg.method);
+            let origin = AcquisitionMethod::from_u8(msg.method)
+                .ok()
+                .and_then(|m| rank(&self.methods, m));
             if let Some(v) = &mut self.verifier {
                 v.reset(origin);
             }
@@ -272,6 +273,11 @@ impl InitNode {
                 .on_acquisition(done.sequence, accepted, published_ns),
         );
     }
+}
+
+/// The rank of `method` in the chain (0: the most trusted).
+fn rank(methods: &[AcquisitionMethod], method: AcquisitionMethod) -> Option<usize> {
+    methods.iter().position(|m| *m == method)
 }
 
 fn log_event(event: Event) {

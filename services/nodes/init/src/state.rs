@@ -186,7 +186,23 @@ pub struct InitStateMachine {
     instances: HashMap<Name, (u64, WireStatus)>,
     /// Frame the current need for a pose started from (loss, or first frame).
     need_since: Option<u64>,
+    /// When the last accepted result was published (CLOCK_REALTIME ns).
+    handed_over_ns: Option<i64>,
     stats: InitStats,
+}
+
+impl EstimateInfo {
+    /// True when the tracker provably started this frame before
+    /// `published_ns` (both times known): it had not applied that result.
+    fn started_before(&self, published_ns: Option<i64>) -> bool {
+        matches!((self.started_ns, published_ns), (Some(s), Some(p)) if s < p)
+    }
+
+    /// True when the tracker provably started this frame after
+    /// `published_ns`.
+    fn started_after(&self, published_ns: Option<i64>) -> bool {
+        matches!((self.started_ns, published_ns), (Some(s), Some(p)) if s > p)
+    }
 }
 
 impl InitStateMachine {
@@ -198,6 +214,7 @@ impl InitStateMachine {
             phase: Phase::Listening,
             instances: HashMap::new(),
             need_since: None,
+            handed_over_ns: None,
             stats: InitStats::default(),
         })
     }
@@ -267,9 +284,7 @@ impl InitStateMachine {
                 frame: from,
                 published_ns,
             } if !tracked && frame > from => {
-                let after_result =
-                    matches!((e.started_ns, published_ns), (Some(s), Some(p)) if s > p);
-                if after_result || frame > from + self.config.handover_frames {
+                if e.started_after(published_ns) || frame > from + self.config.handover_frames {
                     self.stats.losses += 1;
                     self.need(frame);
                     Event::HandoverFailed { frame }
@@ -295,6 +310,7 @@ impl InitStateMachine {
             let delay_frames = self.need_since.map(|s| frame.saturating_sub(s));
             self.stats.last_delay_frames = delay_frames;
             self.need_since = None;
+            self.handed_over_ns = published_ns;
             self.phase = Phase::HandedOver {
                 frame,
                 published_ns,
@@ -311,6 +327,12 @@ impl InitStateMachine {
             };
             Event::Rejected { frame, retry_from }
         }
+    }
+
+    /// True when `e` is an estimate of the current track: not one the
+    /// tracker provably started before the last accepted result went out.
+    pub fn of_current_track(&self, e: &EstimateInfo) -> bool {
+        !e.started_before(self.handed_over_ns)
     }
 
     fn need(&mut self, frame: u64) {

@@ -135,6 +135,24 @@ struct Offset {
     translation_target: Vector3<f64>,
 }
 
+impl Offset {
+    /// The offset of `pose` from `track`, in the track's body frame.
+    fn of(track: &Pose, pose: &Pose) -> Offset {
+        Offset {
+            rotation: track.rotation.transpose() * pose.rotation,
+            translation_target: track.rotation.transpose() * (pose.translation - track.translation),
+        }
+    }
+
+    /// The offset from this one to `other`.
+    fn to(&self, other: &Offset) -> Offset {
+        Offset {
+            rotation: self.rotation.transpose() * other.rotation,
+            translation_target: other.translation_target - self.translation_target,
+        }
+    }
+}
+
 /// The verification state of the current track.
 #[derive(Debug, Clone)]
 pub struct Verifier {
@@ -215,7 +233,7 @@ impl Verifier {
         else {
             return Verdict::Unknown;
         };
-        let offset = self.offset(&track.t_sensor_target, &pose);
+        let offset = Offset::of(&track.t_sensor_target, &pose);
         if self.small(&offset) {
             self.agreements += 1;
             self.contradiction = None;
@@ -229,8 +247,7 @@ impl Verifier {
         }
         let in_a_row = match self.contradiction {
             Some((before, at, n))
-                if sequence <= at + MAX_CONTRADICTION_GAP
-                    && self.small(&self.between(&before, &offset)) =>
+                if sequence <= at + MAX_CONTRADICTION_GAP && self.small(&before.to(&offset)) =>
             {
                 n + 1
             }
@@ -245,22 +262,6 @@ impl Verifier {
             };
         }
         Verdict::Contradicts { in_a_row, off_deg }
-    }
-
-    /// The offset of `pose` from `track`, in the track's body frame.
-    fn offset(&self, track: &Pose, pose: &Pose) -> Offset {
-        Offset {
-            rotation: track.rotation.transpose() * pose.rotation,
-            translation_target: track.rotation.transpose() * (pose.translation - track.translation),
-        }
-    }
-
-    /// The offset from `a` to `b`.
-    fn between(&self, a: &Offset, b: &Offset) -> Offset {
-        Offset {
-            rotation: a.rotation.transpose() * b.rotation,
-            translation_target: b.translation_target - a.translation_target,
-        }
     }
 
     /// The attitude part of an offset up to the target's symmetries (rad).
