@@ -1,0 +1,105 @@
+//! The verification of a hand-over through the node (`crate::verify`),
+//! with scripted methods so that the chain's answers are known.
+
+use super::*;
+
+/// A method whose answers are scripted per call: the `k`-th call answers
+/// `script[k]` (the last one after that): a pose, accepted or not.
+struct Scripted {
+    method: AcquisitionMethod,
+    script: Vec<Option<Pose>>,
+    calls: std::sync::atomic::AtomicUsize,
+}
+
+impl PoseAcquirer for Scripted {
+    fn method(&self) -> AcquisitionMethod {
+        self.method
+    }
+
+    fn acquire(&self, _: &[Point]) -> Result<MethodOutput, InitError> {
+        let k = self.calls.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        let answer = self.script[k.min(self.script.len() - 1)];
+        Ok(MethodOutput {
+            t_sensor_target: answer.unwrap_or_else(Pose::identity),
+            f_conv_m2: 1e-3,
+            accepted: answer.is_some(),
+            detail: String::new(),
+        })
+    }
+}
+
+/// The tracker's `tracking` estimate of `sequence` at `pose`, started
+/// after the last result went out.
+fn tracking_at(sequence: u64, pose: &Pose) -> PoseEstimate {
+    let mut e = tracker(
+        sequence,
+        WireStatus::Tracking,
+        realtime_ns() + 1_000_000_000,
+    );
+    e.set_pose(pose);
+    e
+}
+
+/// Template matching (the fallback) hands over a pose on deos' 60° twin;
+/// the CNN, rejected on the first frame, finds the truth on the next two:
+/// the verification replaces the track with the CNN's pose, published as
+/// an acquisition; the new track (the CNN's) is not verified.
+#[test]
+fn a_fallback_track_the_cnn_contradicts_twice_is_replaced() {
+    use nalgebra::{Rotation3, Vector3};
+    let truth = Pose::new(
+        Rotation3::from_euler_angles(0.3, 0.2, 0.1),
+        Vector3::new(0.0, 0.0, 15.0),
+    );
+    let twin = Pose::new(
+        truth.rotation * Rotation3::from_axis_angle(&Vector3::x_axis(), 60f64.to_radians()),
+        truth.translation,
+    );
+    let scripted = |method, script| -> Box<dyn PoseAcquirer> {
+        Box::new(Scripted {
+            method,
+            script,
+            calls: 0.into(),
+        })
+    };
+    let chain = MethodChain::new(
+        vec![
+            scripted(AcquisitionMethod::Cnn, vec![None, Some(truth)]),
+            scripted(AcquisitionMethod::TemplateMatching, vec![Some(twin)]),
+        ],
+        3,
+    )
+    .unwrap();
+    let deos = Target::builtin("deos").unwrap();
+    let verifier = Verifier::new(
+        crate::verify::VerifyConfig::default(),
+        deos.symmetries().to_vec(),
+        deos.bounding_radius(),
+    );
+    let node = InitNode::with_chain(chain, InitConfig::default(), Name::new("init").unwrap());
+    let mut h = Harness::new(node.unwrap().with_verifier(verifier));
+    let points = vec![Point::new(0.0, 0.0, 15.0, 1.0, 0.0); 5];
+
+    assert!(h.cloud(0, &points).is_empty());
+    h.estimate(tracker(0, WireStatus::Lost, NOW_NS));
+    let first = h.finished();
+    assert_eq!(first.method, AcquisitionMethod::TemplateMatching as u8);
+    // Frame 1: the track (on the twin) is verified; the CNN contradicts it.
+    assert!(h.cloud(1, &points).is_empty());
+    h.estimate(tracking_at(1, &twin));
+    assert!(h.node.busy(), "a verification runs");
+    // Frame 2 arrives while it runs; its verification follows.
+    assert!(h.cloud(2, &points).is_empty());
+    h.estimate(tracking_at(2, &twin));
+    let replaced = h.finished();
+    assert_eq!(replaced.sequence, 2);
+    assert_eq!(replaced.method, AcquisitionMethod::Cnn as u8);
+    let (deg, m) = replaced.pose().unwrap().error_to(&truth);
+    assert!(deg < 1e-9 && m < 1e-9, "{deg} deg, {m} m");
+    assert!(matches!(h.node.phase(), Phase::HandedOver { frame: 2, .. }));
+    // The CNN's own track is not verified.
+    h.estimate(tracking_at(3, &truth));
+    assert!(h.cloud(3, &points).is_empty());
+    assert!(!h.node.busy());
+    assert_eq!(h.counters.frames_out, 2, "verifications are not published");
+}
