@@ -5,7 +5,7 @@
 //! acquisitions, which telemetry does not carry, as [`AcquisitionRecord`].
 
 use serde::{Deserialize, Serialize};
-use spacepose_messages::{AcquisitionMethod, AcquisitionResult, MessageError};
+use spacepose_messages::{AcquisitionMethod, AcquisitionResult, MessageError, Verification};
 
 /// An acquisition: how, whether it succeeded, and the pose it found.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -16,6 +16,11 @@ pub struct AcquisitionRecord {
     pub method: String,
     /// Whether the pose is valid (the tracker and the filter take it).
     pub accepted: bool,
+    /// `"trusted"`, `"pending"` (the track awaits its verification) or
+    /// `"confirms"` (not an acquisition: confirms the one of `sequence`);
+    /// recordings from before the field read `"trusted"`.
+    #[serde(default = "trusted")]
+    pub verification: String,
     /// Sequence of the cloud frame it was computed from.
     pub sequence: u64,
     /// Time of validity (s, sensor clock).
@@ -40,6 +45,7 @@ impl AcquisitionRecord {
             instance: m.instance.as_str().to_string(),
             method: AcquisitionMethod::from_u8(m.method)?.as_str().to_string(),
             accepted: m.success == 1,
+            verification: Verification::from_u8(m.verification)?.as_str().to_string(),
             sequence: m.sequence,
             t_s: m.t_s,
             q_sensor_target: m.q_sensor_target,
@@ -48,6 +54,10 @@ impl AcquisitionRecord {
             time_ms: m.time_ms,
         })
     }
+}
+
+fn trusted() -> String {
+    Verification::Trusted.as_str().to_string()
 }
 
 #[cfg(test)]
@@ -67,7 +77,21 @@ mod tests {
             ("template-matching", true, 3)
         );
         assert_eq!(r.p_sensor_target_m, [0.0, 0.0, 40.0]);
+        assert_eq!(r.verification, "trusted");
+        m.verification = Verification::Pending as u8;
+        assert_eq!(
+            AcquisitionRecord::from_wire(&m).unwrap().verification,
+            "pending"
+        );
+        m.verification = 7;
+        assert!(AcquisitionRecord::from_wire(&m).is_err());
+        m.verification = 0;
         m.method = 9;
         assert!(AcquisitionRecord::from_wire(&m).is_err());
+        // A recording from before the field reads "trusted".
+        let mut json = serde_json::to_value(&r).unwrap();
+        json.as_object_mut().unwrap().remove("verification");
+        let old: AcquisitionRecord = serde_json::from_value(json).unwrap();
+        assert_eq!(old.verification, "trusted");
     }
 }

@@ -46,6 +46,50 @@ impl AcquisitionMethod {
     }
 }
 
+/// Whether the track an acquisition starts awaits its verification by the
+/// init service (stored as `u8` in [`AcquisitionResult::verification`];
+/// `services/nodes/init/src/verify.rs`, design note
+/// `docs/design/acquisition-verification.md`).
+#[repr(u8)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Verification {
+    /// The method is trusted (the chain's first, the truth, a given pose):
+    /// the track it starts is `tracking` at once.
+    Trusted = 0,
+    /// A fallback method acquired: the track it starts is published
+    /// `unconfirmed` until a record with [`Verification::Confirms`] for
+    /// this acquisition's frame follows (or a new acquisition replaces it).
+    Pending = 1,
+    /// Not an acquisition: confirms the track that the acquisition of
+    /// frame `sequence` started (the pose is that acquisition's). Consumers
+    /// that start tracks ignore it ([`crate::convert::acquisition_pose`]).
+    Confirms = 2,
+}
+
+impl Verification {
+    /// Decodes the `u8` code.
+    pub fn from_u8(code: u8) -> Result<Verification, MessageError> {
+        match code {
+            0 => Ok(Verification::Trusted),
+            1 => Ok(Verification::Pending),
+            2 => Ok(Verification::Confirms),
+            _ => Err(MessageError::UnknownCode {
+                what: "verification",
+                code,
+            }),
+        }
+    }
+
+    /// Lower-case name (`"trusted"`, `"pending"`, `"confirms"`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Verification::Trusted => "trusted",
+            Verification::Pending => "pending",
+            Verification::Confirms => "confirms",
+        }
+    }
+}
+
 /// An initial estimate of `t_sensor_target` for the tracker and the filter.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend, Serialize, Deserialize)]
@@ -57,6 +101,10 @@ pub struct AcquisitionResult {
     pub method: u8,
     /// 1 when the acquisition succeeded (the pose is valid), 0 otherwise.
     pub success: u8,
+    /// [`Verification`] code: whether the track this starts awaits the
+    /// init service's verification, or (`Confirms`) a confirmation of the
+    /// track started at `sequence`, not an acquisition.
+    pub verification: u8,
     /// Sequence of the cloud frame the pose was computed from.
     pub sequence: u64,
     /// Time of validity of the pose (s, sensor clock).
@@ -82,6 +130,17 @@ impl AcquisitionResult {
             ..Self::default()
         }
     }
+
+    /// The frame of the acquisition this record confirms, when it is a
+    /// confirmation ([`Verification::Confirms`]) rather than an acquisition.
+    pub fn confirms(&self) -> Option<u64> {
+        (self.verification == Verification::Confirms as u8).then_some(self.sequence)
+    }
+
+    /// True when this record starts a track that awaits verification.
+    pub fn pending(&self) -> bool {
+        self.success == 1 && self.verification == Verification::Pending as u8
+    }
 }
 
 impl WireMessage for AcquisitionResult {
@@ -95,6 +154,11 @@ impl WireMessage for AcquisitionResult {
     fn validate(&self) -> Result<(), CodecError> {
         check_code("method", self.method, AcquisitionMethod::Given as u8)?;
         check_code("success", self.success, 1)?;
+        check_code(
+            "verification",
+            self.verification,
+            Verification::Confirms as u8,
+        )?;
         check_name("instance", &self.instance)
     }
 }

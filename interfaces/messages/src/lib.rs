@@ -26,7 +26,7 @@ pub mod pose;
 pub mod telemetry;
 pub mod truth;
 
-pub use acquisition::{AcquisitionMethod, AcquisitionResult};
+pub use acquisition::{AcquisitionMethod, AcquisitionResult, Verification};
 pub use clock::{elapsed_ms, realtime_ns};
 pub use cloud::{CloudHeader, CloudMsg, MAX_POINTS, WirePoint, as_points, as_wire};
 pub use codec::{WireMessage, decode, encode};
@@ -45,4 +45,4 @@ pub use truth::TruthMsg;
 pub use iceoryx2::prelude::ZeroCopySend;
 
 /// Version of the wire schema (the codec envelope and every `schema` field).
-pub const SCHEMA_VERSION: u16 = 5;
+pub const SCHEMA_VERSION: u16 = 6;

@@ -19,6 +19,11 @@ pub enum WireStatus {
     Degraded = 1,
     /// The track is lost and must be re-acquired.
     Lost = 2,
+    /// As `Tracking` (converged, good quality, fused by the filter), but
+    /// the acquisition that started the track awaits the init service's
+    /// verification ([`crate::Verification::Pending`]): not to be acted on
+    /// as a confirmed pose.
+    Unconfirmed = 3,
 }
 
 impl WireStatus {
@@ -28,6 +33,7 @@ impl WireStatus {
             0 => Ok(WireStatus::Tracking),
             1 => Ok(WireStatus::Degraded),
             2 => Ok(WireStatus::Lost),
+            3 => Ok(WireStatus::Unconfirmed),
             _ => Err(MessageError::UnknownCode {
                 what: "status",
                 code,
@@ -35,13 +41,21 @@ impl WireStatus {
         }
     }
 
-    /// Lower-case name (`"tracking"`, `"degraded"`, `"lost"`).
+    /// Lower-case name (`"tracking"`, `"degraded"`, `"lost"`,
+    /// `"unconfirmed"`).
     pub fn as_str(self) -> &'static str {
         match self {
             WireStatus::Tracking => "tracking",
             WireStatus::Degraded => "degraded",
             WireStatus::Lost => "lost",
+            WireStatus::Unconfirmed => "unconfirmed",
         }
+    }
+
+    /// True for a registration the filter fuses: `tracking`, or
+    /// `unconfirmed` (the same quality, the track's start not yet verified).
+    pub fn is_tracked(self) -> bool {
+        matches!(self, WireStatus::Tracking | WireStatus::Unconfirmed)
     }
 }
 
@@ -128,7 +142,7 @@ impl WireMessage for PoseEstimate {
     }
 
     fn validate(&self) -> Result<(), CodecError> {
-        check_code("status", self.status, WireStatus::Lost as u8)?;
+        check_code("status", self.status, WireStatus::Unconfirmed as u8)?;
         check_code("mode", self.mode, TrackingMode::MAX_CODE)?;
         check_code("held_axes", self.held_axes, 3)?;
         check_code("held_translations", self.held_translations, 3)?;

@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 use spacepose_geometry::Euler321;
 
 /// Version of the JSON telemetry schema (bumped on any incompatible change).
-pub const TELEMETRY_SCHEMA_VERSION: u16 = 3;
+pub const TELEMETRY_SCHEMA_VERSION: u16 = 4;
 
 /// Key suffixes below `spacepose/{prefix}/telemetry/`.
 pub mod keys {
@@ -54,7 +54,8 @@ pub struct TelemetryPose {
     pub sequence: u64,
     /// Time of validity (s, sensor clock; scan end).
     pub t_s: f64,
-    /// `"tracking"`, `"degraded"` or `"lost"`.
+    /// `"tracking"`, `"degraded"`, `"lost"` or `"unconfirmed"` (tracked,
+    /// but the acquisition that started the track awaits its verification).
     pub status: String,
     /// Registration mode: `"ndt"`, `"deblur"`, `"ct-ndt"` or `"icp"`.
     pub mode: String,
@@ -277,7 +278,8 @@ pub struct TelemetryErrors {
     pub sequence: u64,
     /// Time of validity (s, sensor clock).
     pub t_s: f64,
-    /// Track status of the estimate (`"tracking"`, `"degraded"`, `"lost"`).
+    /// Track status of the estimate (`"tracking"`, `"degraded"`, `"lost"`,
+    /// `"unconfirmed"`).
     pub status: String,
     /// Rotation angle between estimated and true `R_sensor_target` (deg).
     pub ang_err_deg: f64,

@@ -36,7 +36,7 @@ fn messages_are_counted_and_malformed_ones_flagged() {
 /// A pose of `instance` at (3, 4, 12) m, i.e. 13 m away.
 fn pose(instance: &str, latency_ms: Option<f64>) -> TelemetryPose {
     serde_json::from_value(json!({
-        "schema_version": 3, "instance": instance, "sequence": 42, "t_s": 4.2,
+        "schema_version": 4, "instance": instance, "sequence": 42, "t_s": 4.2,
         "status": "degraded", "mode": "track", "q_sensor_target": [1.0, 0.0, 0.0, 0.0],
         "p_sensor_target_m": [3.0, 4.0, 12.0], "euler_321_deg": [10.04, -20.06, 179.96],
         "sigma_rot_deg": [0.1, 0.1, 0.1], "sigma_pos_cm": [1.0, 1.0, 1.0],
@@ -50,7 +50,7 @@ fn pose(instance: &str, latency_ms: Option<f64>) -> TelemetryPose {
 /// Errors of `instance` against truth.
 fn errors(instance: &str, ang_err_deg: f64, pos_err_cm: f64) -> TelemetryErrors {
     serde_json::from_value(json!({
-        "schema_version": 3, "instance": instance, "sequence": 42, "t_s": 4.2,
+        "schema_version": 4, "instance": instance, "sequence": 42, "t_s": 4.2,
         "status": "degraded", "ang_err_deg": ang_err_deg, "pos_err_cm": pos_err_cm,
         "latency_ms": null
     }))
@@ -113,7 +113,7 @@ fn pose_rows_show_range_and_the_errors_of_the_same_tracker() {
 fn health_rows_sum_every_kind_of_rejection() {
     let mut s = GroundState::default();
     let h: TelemetryHealth = serde_json::from_value(json!({
-        "schema_version": 3, "service": "tracker", "instance": "t1", "state": "running",
+        "schema_version": 4, "service": "tracker", "instance": "t1", "state": "running",
         "pid": 7, "sequence": 3, "last_frame": 99, "uptime_s": 1.0, "frames_in": 120,
         "frames_out": 110, "rejected_non_finite": 1, "rejected_empty": 20,
         "rejected_oversized": 300, "rejected_wire": 4000, "errors": 5, "published_ns": 0

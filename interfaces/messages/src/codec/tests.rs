@@ -30,7 +30,7 @@ fn cov(rng: &mut impl Rng) -> [[f64; 6]; 6] {
 pub(super) fn pose_estimate(rng: &mut impl Rng) -> PoseEstimate {
     PoseEstimate {
         schema: SCHEMA_VERSION,
-        status: rng.random_range(0..3),
+        status: rng.random_range(0..4),
         mode: rng.random_range(0..4),
         held_axes: rng.random_range(0..4),
         held_translations: rng.random_range(0..4),
@@ -73,6 +73,7 @@ pub(super) fn acquisition(rng: &mut impl Rng) -> AcquisitionResult {
         schema: SCHEMA_VERSION,
         method: rng.random_range(0..3),
         success: 1,
+        verification: rng.random_range(0..3),
         sequence: rng.random(),
         t_s: f(rng),
         q_sensor_target: arr(rng),
@@ -239,6 +240,12 @@ fn content_is_validated_after_decoding() {
     let mut bad_status = pose_estimate(&mut rng);
     bad_status.status = 7;
     assert!(matches!(encode(&bad_status), Err(CodecError::Invalid(_))));
+    let mut bad_verification = acquisition(&mut rng);
+    bad_verification.verification = 3;
+    assert!(matches!(
+        encode(&bad_verification),
+        Err(CodecError::Invalid(_))
+    ));
     let mut bad_held = pose_estimate(&mut rng);
     bad_held.held_axes = 4;
     assert!(matches!(encode(&bad_held), Err(CodecError::Invalid(_))));

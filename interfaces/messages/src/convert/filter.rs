@@ -127,10 +127,12 @@ pub fn measurement_from_estimate(e: &PoseEstimate) -> Result<Measurement, Messag
     })
 }
 
-/// The initial pose of a successful acquisition (`Ok(None)` when it failed).
+/// The initial pose of a successful acquisition (`Ok(None)` when it failed,
+/// or when the record confirms an earlier acquisition instead of starting a
+/// track: [`AcquisitionResult::confirms`]).
 pub fn acquisition_pose(a: &AcquisitionResult) -> Result<Option<(f64, Pose)>, MessageError> {
     const WHAT: &str = "AcquisitionResult";
-    if a.success == 0 {
+    if a.success == 0 || a.confirms().is_some() {
         return Ok(None);
     }
     if !a.t_s.is_finite() {
@@ -149,6 +151,7 @@ pub fn zero_rates() -> (Vector3<f64>, Vector3<f64>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Verification;
     use spacepose_filter::FilterConfig;
     use spacepose_geometry::so3;
 
@@ -237,6 +240,13 @@ mod tests {
         let (t, pose) = acquisition_pose(&a).unwrap().unwrap();
         assert_eq!(t, 1.5);
         assert!(pose.translation.norm() == 0.0);
+        // A pending acquisition starts a track; a confirmation does not.
+        a.verification = Verification::Pending as u8;
+        assert!(a.pending() && acquisition_pose(&a).unwrap().is_some());
+        a.verification = Verification::Confirms as u8;
+        assert_eq!(a.confirms(), Some(a.sequence));
+        assert_eq!(acquisition_pose(&a).unwrap(), None);
+        a.verification = Verification::Trusted as u8;
         a.t_s = f64::NAN;
         assert!(acquisition_pose(&a).is_err());
     }

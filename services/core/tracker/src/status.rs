@@ -19,6 +19,12 @@ pub enum TrackStatus {
     /// The registration failed, or too many degraded frames in a row: the
     /// track must be re-acquired ([`crate::Tracker::initialize`]).
     Lost,
+    /// As `Tracking`, but the acquisition that started the track awaits
+    /// its verification. Never from [`crate::Tracker`] itself: the tracker
+    /// service publishes its `Tracking` frames so while the init service
+    /// has not confirmed a fallback method's acquisition (wire
+    /// `Verification::Pending`, `docs/design/acquisition-verification.md`).
+    Unconfirmed,
 }
 
 impl TrackStatus {
@@ -28,6 +34,7 @@ impl TrackStatus {
             Self::Tracking => "tracking",
             Self::Degraded => "degraded",
             Self::Lost => "lost",
+            Self::Unconfirmed => "unconfirmed",
         }
     }
 }

@@ -210,10 +210,10 @@ impl Fuser {
         self.fuse_all(choices)
     }
 
-    /// Usable for fusion: `tracking` and within the disagreement bounds of
+    /// Usable for fusion: `tracking` (or `unconfirmed`) and within the disagreement bounds of
     /// the prediction (when there is one after the filter's time).
     fn quality(&self, m: &Measurement) -> Quality {
-        if m.status != WireStatus::Tracking {
+        if !m.status.is_tracked() {
             return Quality::NotTracking;
         }
         let predicted = match self.filter.time() {
@@ -257,7 +257,7 @@ impl Fuser {
     /// Checks and fuses the estimate chosen for a frame. Errors on a filter
     /// failure (the state is then unchanged).
     fn fuse(&mut self, m: &Measurement) -> Result<EstimateOutcome, FilterError> {
-        if m.status != WireStatus::Tracking {
+        if !m.status.is_tracked() {
             return Ok(EstimateOutcome::NotTracking(m.status));
         }
         let Some(t_filter) = self.filter.time() else {

@@ -14,6 +14,9 @@
 //! result is compared with the tracker's pose of that frame instead of
 //! being published; a track that a more trusted method contradicts is
 //! replaced by publishing the newest contradicting pose as an acquisition.
+//! Such an acquisition goes out `Verification::Pending` (the tracker
+//! publishes the track `unconfirmed`); once the verifications confirm it,
+//! a record `Verification::Confirms` of the same frame follows.
 
 use crate::chain::MethodChain;
 use crate::config::InitServiceConfig;
@@ -21,7 +24,8 @@ use crate::state::{EstimateInfo, Event, InitConfig, InitStateMachine, InitStats,
 use crate::verify::{TrackedPose, Verdict, Verifier};
 use crate::worker::{Done, Frame, Worker};
 use spacepose_messages::{
-    AcquisitionMethod, Cloud, Message, Name, PoseEstimate, ServiceKind, WireStatus, realtime_ns,
+    AcquisitionMethod, AcquisitionResult, Cloud, Message, Name, PoseEstimate, ServiceKind,
+    Verification, realtime_ns,
 };
 use spacepose_runtime::{Ctx, Flow, Node, NodeInfo};
 use std::time::Instant;
@@ -43,6 +47,8 @@ pub struct InitNode {
     methods: Vec<AcquisitionMethod>,
     /// The worker verifies (it does not acquire).
     verifying: bool,
+    /// The published acquisition whose track awaits its confirmation.
+    pending: Option<AcquisitionResult>,
 }
 
 impl Node for InitNode {
@@ -136,6 +142,7 @@ impl InitNode {
             wake_ns: None,
             verifier: None,
             verifying: false,
+            pending: None,
         })
     }
 
@@ -190,7 +197,7 @@ impl InitNode {
             return;
         };
         let current = self.machine.of_current_track(e);
-        let tracking = e.status == WireStatus::Tracking && self.machine.phase() == Phase::Tracking;
+        let tracking = e.status.is_tracked() && self.machine.phase() == Phase::Tracking;
         if let (true, true, Ok(pose)) = (current, tracking, estimate.pose()) {
             verifier.on_tracked(TrackedPose {
                 sequence: e.sequence,
@@ -222,6 +229,9 @@ impl InitNode {
             "verification: {}",
             done.acquisition.summary()
         );
+        if let Verdict::Agrees { confirmed: true } = verdict {
+            self.confirm(ctx);
+        }
         if let Verdict::Replace { off_deg, .. } = verdict {
             warn!(
                 sequence = done.sequence,
@@ -239,7 +249,15 @@ impl InitNode {
         if done.points_in > 0 && acquisition.points < done.points_in {
             ctx.counters.rejected_non_finite += 1;
         }
-        let msg = acquisition.to_wire(done.sequence, done.scan_end_s, self.instance);
+        let mut msg = acquisition.to_wire(done.sequence, done.scan_end_s, self.instance);
+        let origin = AcquisitionMethod::from_u8(msg.method)
+            .ok()
+            .and_then(|m| rank(&self.methods, m))
+            .filter(|_| msg.success == 1);
+        let verified = self.verifier.is_some() && origin.is_some_and(|r| r > 0);
+        if verified {
+            msg.verification = Verification::Pending as u8;
+        }
         // Stamped after the send: a tracker frame started before the result
         // went out must not count as started after it (hand-over check).
         // The wake-up time `now_ns` is earlier; a LocalBus clock ahead of
@@ -255,22 +273,36 @@ impl InitNode {
             sequence = done.sequence,
             success = msg.success,
             method = msg.method,
+            pending = verified,
             f_conv_m2 = msg.f_conv_m2,
             time_ms = acquisition.time_ms,
             "acquisition: {}",
             acquisition.summary()
         );
         if accepted {
-            let origin = AcquisitionMethod::from_u8(msg.method)
-                .ok()
-                .and_then(|m| rank(&self.methods, m));
             if let Some(v) = &mut self.verifier {
                 v.reset(origin);
             }
+            self.pending = verified.then_some(msg);
         }
         log_event(
             self.machine
                 .on_acquisition(done.sequence, accepted, published_ns),
+        );
+    }
+
+    /// The verifications confirmed the track: the record that says so.
+    fn confirm(&mut self, ctx: &mut Ctx<'_>) {
+        let Some(mut msg) = self.pending.take() else {
+            return;
+        };
+        msg.verification = Verification::Confirms as u8;
+        if ctx.send(&Message::Acquisition(msg)) {
+            ctx.counters.frames_out += 1;
+        }
+        info!(
+            sequence = msg.sequence,
+            "the verifications confirm the track"
         );
     }
 }

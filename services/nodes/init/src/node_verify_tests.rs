@@ -40,21 +40,9 @@ fn tracking_at(sequence: u64, pose: &Pose) -> PoseEstimate {
     e
 }
 
-/// Template matching (the fallback) hands over a pose on deos' 60° twin;
-/// the CNN, rejected on the first frame, finds the truth on the next two:
-/// the verification replaces the track with the CNN's pose, published as
-/// an acquisition; the new track (the CNN's) is not verified.
-#[test]
-fn a_fallback_track_the_cnn_contradicts_twice_is_replaced() {
-    use nalgebra::{Rotation3, Vector3};
-    let truth = Pose::new(
-        Rotation3::from_euler_angles(0.3, 0.2, 0.1),
-        Vector3::new(0.0, 0.0, 15.0),
-    );
-    let twin = Pose::new(
-        truth.rotation * Rotation3::from_axis_angle(&Vector3::x_axis(), 60f64.to_radians()),
-        truth.translation,
-    );
+/// A node whose chain is the CNN then template matching, each scripted,
+/// verifying with the defaults on deos.
+fn verifying_node(cnn: Vec<Option<Pose>>, tm: Vec<Option<Pose>>) -> Harness {
     let scripted = |method, script| -> Box<dyn PoseAcquirer> {
         Box::new(Scripted {
             method,
@@ -64,8 +52,8 @@ fn a_fallback_track_the_cnn_contradicts_twice_is_replaced() {
     };
     let chain = MethodChain::new(
         vec![
-            scripted(AcquisitionMethod::Cnn, vec![None, Some(truth)]),
-            scripted(AcquisitionMethod::TemplateMatching, vec![Some(twin)]),
+            scripted(AcquisitionMethod::Cnn, cnn),
+            scripted(AcquisitionMethod::TemplateMatching, tm),
         ],
         3,
     )
@@ -77,13 +65,40 @@ fn a_fallback_track_the_cnn_contradicts_twice_is_replaced() {
         deos.bounding_radius(),
     );
     let node = InitNode::with_chain(chain, InitConfig::default(), Name::new("init").unwrap());
-    let mut h = Harness::new(node.unwrap().with_verifier(verifier));
+    Harness::new(node.unwrap().with_verifier(verifier))
+}
+
+fn truth() -> Pose {
+    use nalgebra::{Rotation3, Vector3};
+    Pose::new(
+        Rotation3::from_euler_angles(0.3, 0.2, 0.1),
+        Vector3::new(0.0, 0.0, 15.0),
+    )
+}
+
+/// Template matching (the fallback) hands over a pose on deos' 60° twin;
+/// the CNN, rejected on the first frame, finds the truth on the next two:
+/// the verification replaces the track with the CNN's pose, published as
+/// an acquisition; the new track (the CNN's) is not verified.
+#[test]
+fn a_fallback_track_the_cnn_contradicts_twice_is_replaced() {
+    use nalgebra::{Rotation3, Vector3};
+    let truth = truth();
+    let twin = Pose::new(
+        truth.rotation * Rotation3::from_axis_angle(&Vector3::x_axis(), 60f64.to_radians()),
+        truth.translation,
+    );
+    let mut h = verifying_node(vec![None, Some(truth)], vec![Some(twin)]);
     let points = vec![Point::new(0.0, 0.0, 15.0, 1.0, 0.0); 5];
 
     assert!(h.cloud(0, &points).is_empty());
     h.estimate(tracker(0, WireStatus::Lost, NOW_NS));
     let first = h.finished();
     assert_eq!(first.method, AcquisitionMethod::TemplateMatching as u8);
+    assert!(
+        first.pending(),
+        "a fallback's track awaits its verification"
+    );
     // Frame 1: the track (on the twin) is verified; the CNN contradicts it.
     assert!(h.cloud(1, &points).is_empty());
     h.estimate(tracking_at(1, &twin));
@@ -94,6 +109,7 @@ fn a_fallback_track_the_cnn_contradicts_twice_is_replaced() {
     let replaced = h.finished();
     assert_eq!(replaced.sequence, 2);
     assert_eq!(replaced.method, AcquisitionMethod::Cnn as u8);
+    assert_eq!(replaced.verification, Verification::Trusted as u8);
     let (deg, m) = replaced.pose().unwrap().error_to(&truth);
     assert!(deg < 1e-9 && m < 1e-9, "{deg} deg, {m} m");
     assert!(matches!(h.node.phase(), Phase::HandedOver { frame: 2, .. }));
@@ -102,4 +118,40 @@ fn a_fallback_track_the_cnn_contradicts_twice_is_replaced() {
     assert!(h.cloud(3, &points).is_empty());
     assert!(!h.node.busy());
     assert_eq!(h.counters.frames_out, 2, "verifications are not published");
+}
+
+/// Template matching hands over the true pose; the CNN keeps rejecting
+/// its poses, and template matching finds the track's pose again on the
+/// next two frames (published `unconfirmed` by the tracker): the second
+/// agreement sends one record that confirms the acquisition of frame 0.
+#[test]
+fn a_fallback_track_two_verifications_agree_with_is_confirmed_once() {
+    let truth = truth();
+    let mut h = verifying_node(vec![None], vec![Some(truth)]);
+    let points = vec![Point::new(0.0, 0.0, 15.0, 1.0, 0.0); 5];
+    assert!(h.cloud(0, &points).is_empty());
+    h.estimate(tracker(0, WireStatus::Lost, NOW_NS));
+    let first = h.finished();
+    assert!(first.pending());
+    let unconfirmed_at = |sequence| {
+        let mut e = tracking_at(sequence, &truth);
+        e.status = WireStatus::Unconfirmed as u8;
+        e
+    };
+    assert!(h.cloud(1, &points).is_empty());
+    h.estimate(unconfirmed_at(1));
+    assert!(h.node.busy(), "a verification runs");
+    assert!(h.cloud(2, &points).is_empty());
+    h.estimate(unconfirmed_at(2));
+    let confirms = h.finished();
+    assert_eq!(confirms.confirms(), Some(0), "{confirms:?}");
+    assert_eq!(
+        (confirms.method, confirms.success, confirms.q_sensor_target),
+        (first.method, 1, first.q_sensor_target)
+    );
+    // Confirmed: no verification after that, nothing more published.
+    h.estimate(tracking_at(3, &truth));
+    assert!(h.cloud(3, &points).is_empty());
+    assert!(!h.node.busy());
+    assert_eq!(h.counters.frames_out, 2);
 }

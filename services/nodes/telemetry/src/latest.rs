@@ -21,6 +21,9 @@ pub struct FrameStats {
     pub degraded: u64,
     /// Of which `lost`.
     pub lost: u64,
+    /// Of which `unconfirmed`.
+    #[serde(default)]
+    pub unconfirmed: u64,
     /// Sequence of the newest estimate; `null` before the first.
     pub last_sequence: Option<u64>,
     /// Cloud published → pose published of the newest estimate (ms).
@@ -40,12 +43,14 @@ pub struct FrameStats {
 }
 
 impl FrameStats {
-    /// Counts one estimate of `status` (`"tracking"`, `"degraded"`, `"lost"`).
+    /// Counts one estimate of `status` (`"tracking"`, `"degraded"`,
+    /// `"unconfirmed"`; anything else counts `lost`).
     pub fn count_pose(&mut self, p: &TelemetryPose) {
         self.poses += 1;
         match p.status.as_str() {
             "tracking" => self.tracking += 1,
             "degraded" => self.degraded += 1,
+            "unconfirmed" => self.unconfirmed += 1,
             _ => self.lost += 1,
         }
         self.last_sequence = Some(p.sequence);

@@ -9,6 +9,12 @@
 //! measurement (see [`crate::wire::fill_estimate`]), and fuses nothing: the
 //! init service sees the loss on the first such frame and acquires on the
 //! first frame with enough points after the gap.
+//!
+//! A track started by an acquisition that awaits its verification
+//! (`Verification::Pending`: a fallback method acquired it) is published
+//! `unconfirmed` instead of `tracking` until the init service's record
+//! that confirms that acquisition arrives; everything else is the same
+//! (the filter fuses it).
 
 use crate::config::TrackerServiceConfig;
 use crate::error::{ControlError, invalid};
@@ -19,7 +25,7 @@ use spacepose_geometry::Point;
 use spacepose_messages::convert::{acquisition_pose, prediction_from_state};
 use spacepose_messages::{
     AcquisitionResult, Cloud, CloudHeader, Command, CommandKind, Counters, FilterState, Message,
-    Name, ServiceKind, ServiceState, mode_from_code,
+    Name, ServiceKind, ServiceState, WireStatus, mode_from_code,
 };
 use spacepose_runtime::{Ctx, Node, NodeInfo};
 use spacepose_tracker::{
@@ -50,6 +56,8 @@ pub struct TrackerNode {
     max_points: usize,
     /// The tracker's output for the last cloud, when it reached the tracker.
     last_output: Option<TrackOutput>,
+    /// The frame of the acquisition whose confirmation the track awaits.
+    unconfirmed: Option<u64>,
 }
 
 impl Node for TrackerNode {
@@ -124,6 +132,7 @@ impl TrackerNode {
             instance,
             max_points,
             last_output: None,
+            unconfirmed: None,
         })
     }
 
@@ -146,15 +155,30 @@ impl TrackerNode {
 
     /// A successful acquisition restarts the track at the next frame
     /// (rates unknown: zeros, seed 000 §5.2). Returns whether it was accepted.
+    /// A pending one leaves the track `unconfirmed` until the record that
+    /// confirms it; a confirmation of another acquisition changes nothing.
     ///
     /// # Errors
     /// A message that does not hold a valid pose and time.
     pub fn on_acquisition(&mut self, a: &AcquisitionResult) -> Result<bool, ControlError> {
+        if let Some(sequence) = a.confirms() {
+            if self.unconfirmed == Some(sequence) {
+                self.unconfirmed = None;
+                info!(sequence, "the track is confirmed");
+            }
+            return Ok(false);
+        }
         let Some((t, pose)) = acquisition_pose(a).map_err(invalid("AcquisitionResult"))? else {
             return Ok(false);
         };
         self.track.start_at(t, pose);
+        self.unconfirmed = a.pending().then_some(a.sequence);
         Ok(true)
+    }
+
+    /// True while the track awaits the confirmation of its acquisition.
+    pub fn is_unconfirmed(&self) -> bool {
+        self.unconfirmed.is_some()
     }
 
     /// Keeps the filter service's state for the next frame that starts at
@@ -188,10 +212,12 @@ impl TrackerNode {
             CommandKind::Reinit if c.has_pose() => {
                 let pose = c.pose().map_err(invalid("Command"))?;
                 self.track.start_from(pose);
+                self.unconfirmed = None;
                 Ok(CommandOutcome::ReinitFromPose)
             }
             CommandKind::Reinit => {
                 self.track.drop_track()?;
+                self.unconfirmed = None;
                 Ok(CommandOutcome::ReinitFromAcquisition)
             }
             CommandKind::Swap => Ok(CommandOutcome::Ignored(kind)),
@@ -206,6 +232,10 @@ impl TrackerNode {
         match usable_points(points, self.max_points, &mut result) {
             Some(points) => self.last_output = self.track.track(header, &points, &mut result),
             None => self.track.fill_prediction(&mut result, header.scan_end_s),
+        }
+        let tracking = result.estimate.status == WireStatus::Tracking as u8;
+        if tracking && self.unconfirmed.is_some() {
+            result.estimate.status = WireStatus::Unconfirmed as u8;
         }
         result
     }

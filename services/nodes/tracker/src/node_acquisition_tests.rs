@@ -132,3 +132,42 @@ fn after_a_loss_an_accepted_acquisition_restarts_the_track_and_a_rejected_one_do
     assert!(ang < 1.0 && pos < 0.05, "{ang}° {pos} m");
     assert!(node.is_tracking());
 }
+
+#[test]
+fn a_pending_acquisition_is_tracked_unconfirmed_until_its_own_confirmation() {
+    use spacepose_messages::Verification;
+    let f = &fixture().frames;
+    let instance = Name::new("tracker-t").unwrap();
+    let config = TrackerConfig::with_mode(TrackingMode::Ndt);
+    let mut node =
+        TrackerNode::with_model(config, fixture().model.clone(), instance, 150_000).unwrap();
+    let mut pending = truth_acquisition(&f[0]);
+    pending.verification = Verification::Pending as u8;
+    assert!(node.on_acquisition(&pending).unwrap());
+    assert!(node.is_unconfirmed());
+    let r = node.track_frame(&header(0, &f[0]), &f[0].points);
+    assert_eq!(status(&r), WireStatus::Unconfirmed, "{}", r.reason);
+    // A confirmation of another acquisition changes nothing, and restarts
+    // nothing.
+    let mut other = pending;
+    other.verification = Verification::Confirms as u8;
+    other.sequence += 5;
+    assert!(!node.on_acquisition(&other).unwrap());
+    let r = node.track_frame(&header(1, &f[1]), &f[1].points);
+    assert_eq!(status(&r), WireStatus::Unconfirmed, "{}", r.reason);
+    // Its own confirmation: `tracking` from the next frame, the track kept.
+    let mut confirms = pending;
+    confirms.verification = Verification::Confirms as u8;
+    assert!(!node.on_acquisition(&confirms).unwrap());
+    assert!(!node.is_unconfirmed());
+    let r = node.track_frame(&header(2, &f[2]), &f[2].points);
+    assert_eq!(status(&r), WireStatus::Tracking, "{}", r.reason);
+    let (ang, pos) = errors(&r, &f[2]);
+    assert!(ang < 3.0 && pos < 0.05, "{ang}° {pos} m");
+    // A pending track that a trusted acquisition replaces is `tracking`.
+    assert!(node.on_acquisition(&pending).unwrap());
+    assert!(node.is_unconfirmed());
+    assert!(node.on_acquisition(&truth_acquisition(&f[2])).unwrap());
+    let r = node.track_frame(&header(3, &f[3]), &f[3].points);
+    assert_eq!(status(&r), WireStatus::Tracking, "{}", r.reason);
+}

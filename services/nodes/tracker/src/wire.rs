@@ -12,6 +12,7 @@ pub fn status_to_wire(status: TrackStatus) -> WireStatus {
         TrackStatus::Tracking => WireStatus::Tracking,
         TrackStatus::Degraded => WireStatus::Degraded,
         TrackStatus::Lost => WireStatus::Lost,
+        TrackStatus::Unconfirmed => WireStatus::Unconfirmed,
     }
 }
 

@@ -40,6 +40,13 @@ pub struct Counts {
     pub diverged: usize,
     /// Frames published as tracking while off.
     pub silent: usize,
+    /// Frames published unconfirmed (absent from reports before the
+    /// status existed: none could be).
+    #[serde(default)]
+    pub unconfirmed: usize,
+    /// Of those, frames off.
+    #[serde(default)]
+    pub unconfirmed_far_off: usize,
     /// Acquisitions by verdict (absent from reports started from the truth).
     #[serde(default)]
     pub acquisitions: Acquisitions,
@@ -113,11 +120,14 @@ pub fn table(reports: &[(String, Report)]) -> String {
          report file and mode; \"max\" is each seed's largest error, then its mean / p95 / \
          max over the seeds. Acquisitions: correct / false accepts / rejected, summed over \
          the seeds (a false accept is an accepted pose more than 10° or 50 cm off). \
+         Silent: frames published `tracking` more than 10° or 50 cm off; unconfirmed: \
+         frames published `unconfirmed` (a fallback method's acquisition awaiting its \
+         verification), with those of them that far off. \
          Consistency: each run's median NEES of the published pose and of the filter's \
          posterior, and its median NIS, averaged over the seeds (χ²(6) median 5.3).\n\n",
     );
-    out.push_str("| file | target | scenario | configuration | mode | seeds × frames | angle max: mean / p95 / max (°) | angle mean (95 % CI) (°) | position mean / p95 of max (cm) | lost | diverged | silent | acquisitions | NEES published / filter, NIS |\n");
-    out.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    out.push_str("| file | target | scenario | configuration | mode | seeds × frames | angle max: mean / p95 / max (°) | angle mean (95 % CI) (°) | position mean / p95 of max (cm) | lost | diverged | silent | unconfirmed (far off) | acquisitions | NEES published / filter, NIS |\n");
+    out.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (file, r) in reports {
         for (mode, m) in &r.modes {
             let get = |k: &str| m.stats.get(k).copied();
@@ -125,7 +135,7 @@ pub fn table(reports: &[(String, Report)]) -> String {
             let mean = get("ang_mean_deg");
             let sum = |f: fn(&Counts) -> usize| m.per_seed.iter().map(f).sum::<usize>();
             out.push_str(&format!(
-                "| {file} | {} | {} | {} | {mode} | {} × {} ({}) | {} / {} / {} | {} ({}-{}) | {} / {} | {} | {} | {} | {} | {} |\n",
+                "| {file} | {} | {} | {} | {mode} | {} × {} ({}) | {} / {} / {} | {} ({}-{}) | {} / {} | {} | {} | {} | {} ({}) | {} | {} |\n",
                 r.target,
                 r.scenario,
                 r.configuration,
@@ -143,6 +153,8 @@ pub fn table(reports: &[(String, Report)]) -> String {
                 sum(|c| c.lost),
                 sum(|c| c.diverged),
                 sum(|c| c.silent),
+                sum(|c| c.unconfirmed),
+                sum(|c| c.unconfirmed_far_off),
                 acquisitions(m),
                 consistency(m),
             ));

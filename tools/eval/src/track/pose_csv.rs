@@ -29,13 +29,10 @@ pub struct PoseRow {
     pub acquired: &'static str,
 }
 
-/// `tracking`, `degraded` or `lost` (an unknown code reads `lost`).
+/// `tracking`, `degraded`, `lost` or `unconfirmed` (an unknown code reads
+/// `lost`).
 pub fn status_name(estimate: &PoseEstimate) -> &'static str {
-    match estimate.wire_status() {
-        Ok(WireStatus::Tracking) => "tracking",
-        Ok(WireStatus::Degraded) => "degraded",
-        _ => "lost",
-    }
+    estimate.wire_status().map_or("lost", WireStatus::as_str)
 }
 
 impl PoseRow {

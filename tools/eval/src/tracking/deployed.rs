@@ -49,6 +49,8 @@ pub struct Answer {
     pub output: Option<TrackOutput>,
     /// Acquisitions init published on this frame (accepted or not), with
     /// [`DeployedSuite::with_init`]; they apply from the next frame on.
+    /// Init's records that confirm an earlier acquisition are not among
+    /// them (they are in `sent`).
     pub acquisitions: Vec<AcquisitionResult>,
     /// The filter service's state after the frame, when initialised: the
     /// posterior the tracker's next prediction starts from.
@@ -149,7 +151,7 @@ impl DeployedSuite {
         let acquisitions = sent
             .iter()
             .filter_map(|e| match e {
-                Envelope::Message(Message::Acquisition(a)) => Some(*a),
+                Envelope::Message(Message::Acquisition(a)) if a.confirms().is_none() => Some(*a),
                 _ => None,
             })
             .collect();

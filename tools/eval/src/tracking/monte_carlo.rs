@@ -40,6 +40,11 @@ pub struct SeedFigures {
     pub diverged: usize,
     /// Frames published as `tracking` while more than 10° or 50 cm off.
     pub silent: usize,
+    /// Frames published `unconfirmed` (a fallback method's acquisition
+    /// awaiting its verification).
+    pub unconfirmed: usize,
+    /// Of those, frames more than 10° or 50 cm off.
+    pub unconfirmed_far_off: usize,
     /// Acquisitions by verdict (`--init acquire`; zero from the truth).
     pub acquisitions: AcquisitionCounts,
     /// Median NEES of the published poses' covariance (5.3 when
@@ -187,6 +192,11 @@ pub fn figures(seed: u64, series: &[FrameRecord], warmup: usize) -> SeedFigures 
             .filter(|r| r.status == TrackStatus::Lost || r.far_off())
             .count(),
         silent: series.iter().filter(|r| r.silent()).count(),
+        unconfirmed: count(TrackStatus::Unconfirmed),
+        unconfirmed_far_off: series
+            .iter()
+            .filter(|r| r.status == TrackStatus::Unconfirmed && r.far_off())
+            .count(),
         acquisitions: AcquisitionCounts::of(series.iter().filter_map(|r| r.acquisition.as_ref())),
         nees_median: nees.median_or_nan(),
         nees_above_95: nees.above_95_or_nan(),

@@ -154,6 +154,12 @@ fn notes(report: &TrackingReport) -> String {
                 m.fallback_frames
             );
         }
+        if m.unconfirmed_frames > 0 {
+            s += &format!(
+                "{name}: {} frames unconfirmed (a fallback method's acquisition not yet verified)\n",
+                m.unconfirmed_frames
+            );
+        }
         if m.degraded_frames > 0 {
             let published = if published_prediction(name) {
                 "the filter's prediction was published"
@@ -281,6 +287,7 @@ mod tests {
             pos_err_cm_converged: mm(1.2, 18.0),
             lost_frames: 0,
             degraded_frames,
+            unconfirmed_frames: 0,
             diverged_frames: 0,
             fallback_frames,
             acquisitions: Default::default(),

@@ -139,6 +139,9 @@ pub struct ModeReport {
     pub lost_frames: usize,
     /// Frames the tracker reported degraded.
     pub degraded_frames: usize,
+    /// Frames the tracker published `unconfirmed` (a fallback method's
+    /// acquisition awaiting its verification).
+    pub unconfirmed_frames: usize,
     /// Frames whose true error exceeded 10° or 50 cm (including lost ones).
     pub diverged_frames: usize,
     /// Frames fitted by the stall fallback (`ct-ndt` mode).
@@ -243,6 +246,7 @@ pub fn record(
     let status = match estimate.wire_status() {
         Ok(WireStatus::Tracking) => TrackStatus::Tracking,
         Ok(WireStatus::Degraded) => TrackStatus::Degraded,
+        Ok(WireStatus::Unconfirmed) => TrackStatus::Unconfirmed,
         _ => TrackStatus::Lost,
     };
     let pose = estimate.pose().ok().filter(|_| status != TrackStatus::Lost);
@@ -330,6 +334,7 @@ pub fn summarise(series: Vec<FrameRecord>, warmup: usize) -> ModeReport {
         pos_err_cm_converged: MeanMax::of(&pick(|r| r.pos_err_cm, warmup)),
         lost_frames: count(TrackStatus::Lost),
         degraded_frames: count(TrackStatus::Degraded),
+        unconfirmed_frames: count(TrackStatus::Unconfirmed),
         diverged_frames: diverged,
         fallback_frames: series.iter().filter(|r| r.fallback).count(),
         acquisitions: AcquisitionCounts::of(series.iter().filter_map(|r| r.acquisition.as_ref())),

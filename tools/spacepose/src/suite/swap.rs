@@ -190,7 +190,8 @@ impl SwapJob {
         let mut new_frame = None;
         for p in poses {
             self.newest_frame = self.newest_frame.max(p.sequence);
-            if p.instance.as_str() == self.new && p.status == WireStatus::Tracking as u8 {
+            let tracked = WireStatus::from_u8(p.status).is_ok_and(WireStatus::is_tracked);
+            if p.instance.as_str() == self.new && tracked {
                 new_frame = Some(new_frame.unwrap_or(0).max(p.sequence));
             }
         }

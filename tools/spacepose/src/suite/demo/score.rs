@@ -81,7 +81,7 @@ impl Scorer {
 
     /// Records a pose; returns the frames that became scorable.
     pub fn on_pose(&mut self, p: PoseEstimate) -> Vec<FrameScore> {
-        let tracking = p.status == WireStatus::Tracking as u8;
+        let tracking = WireStatus::from_u8(p.status).is_ok_and(WireStatus::is_tracked);
         self.frames
             .entry(p.sequence)
             .or_insert((p.t_s, p.cloud_published_ns, tracking));
@@ -114,7 +114,7 @@ impl Scorer {
             .collect()
     }
 
-    /// Frames whose first pose was `tracking` but no filter state at its
+    /// Frames whose first pose was `tracking` (or `unconfirmed`: fused too) but no filter state at its
     /// time was seen (no estimate of the frame was fused).
     pub fn unfused_tracking_frames(&self) -> u64 {
         self.frames
