@@ -254,7 +254,8 @@ impl InitNode {
             .ok()
             .and_then(|m| rank(&self.methods, m))
             .filter(|_| msg.success == 1);
-        let verified = self.verifier.is_some() && origin.is_some_and(|r| r > 0);
+        let verified =
+            origin.is_some_and(|r| self.verifier.as_ref().is_some_and(|v| v.verifies(r)));
         if verified {
             msg.verification = Verification::Pending as u8;
         }
@@ -281,7 +282,7 @@ impl InitNode {
         );
         if accepted {
             if let Some(v) = &mut self.verifier {
-                v.reset(origin);
+                v.reset(origin, Some(done.sequence));
             }
             self.pending = verified.then_some(msg);
         }

@@ -79,7 +79,7 @@ fn truth() -> Pose {
 /// Template matching (the fallback) hands over a pose on deos' 60° twin;
 /// the CNN, rejected on the first frame, finds the truth on the next two:
 /// the verification replaces the track with the CNN's pose, published as
-/// an acquisition; the new track (the CNN's) is not verified.
+/// an acquisition; the new track (the CNN's) is verified by agreements.
 #[test]
 fn a_fallback_track_the_cnn_contradicts_twice_is_replaced() {
     use nalgebra::{Rotation3, Vector3};
@@ -109,15 +109,22 @@ fn a_fallback_track_the_cnn_contradicts_twice_is_replaced() {
     let replaced = h.finished();
     assert_eq!(replaced.sequence, 2);
     assert_eq!(replaced.method, AcquisitionMethod::Cnn as u8);
-    assert_eq!(replaced.verification, Verification::Trusted as u8);
+    assert!(
+        replaced.pending(),
+        "the CNN's track awaits its confirmation"
+    );
     let (deg, m) = replaced.pose().unwrap().error_to(&truth);
     assert!(deg < 1e-9 && m < 1e-9, "{deg} deg, {m} m");
     assert!(matches!(h.node.phase(), Phase::HandedOver { frame: 2, .. }));
-    // The CNN's own track is not verified.
-    h.estimate(tracking_at(3, &truth));
-    assert!(h.cloud(3, &points).is_empty());
-    assert!(!h.node.busy());
-    assert_eq!(h.counters.frames_out, 2, "verifications are not published");
+    // The CNN's own track: two agreements confirm it.
+    for k in [3, 4] {
+        h.estimate(tracking_at(k, &truth));
+        assert!(h.cloud(k, &points).is_empty());
+        assert!(h.node.busy(), "frame {k} is verified");
+    }
+    let confirms = h.finished();
+    assert_eq!(confirms.confirms(), Some(2), "{confirms:?}");
+    assert_eq!(h.counters.frames_out, 3, "verifications are not published");
 }
 
 /// Template matching hands over the true pose; the CNN keeps rejecting
@@ -138,11 +145,11 @@ fn a_fallback_track_two_verifications_agree_with_is_confirmed_once() {
         e.status = WireStatus::Unconfirmed as u8;
         e
     };
-    assert!(h.cloud(1, &points).is_empty());
-    h.estimate(unconfirmed_at(1));
-    assert!(h.node.busy(), "a verification runs");
-    assert!(h.cloud(2, &points).is_empty());
-    h.estimate(unconfirmed_at(2));
+    for k in [1, 2] {
+        h.estimate(unconfirmed_at(k));
+        assert!(h.cloud(k, &points).is_empty());
+        assert!(h.node.busy(), "frame {k} is verified");
+    }
     let confirms = h.finished();
     assert_eq!(confirms.confirms(), Some(0), "{confirms:?}");
     assert_eq!(

@@ -27,6 +27,15 @@
 //! while the target turns), are.
 //!
 //! After `confirmations` agreements the track is left alone.
+//!
+//! Until then the track is published `unconfirmed` (the acquisition goes
+//! out `Verification::Pending`, the node sends the record that confirms
+//! it). A track of the chain's first method is verified too
+//! (`confirm_first_method`), by agreements only: nothing replaces it, but
+//! it is not published `tracking` until a second look agrees. Measured on
+//! the development runs, that turns the CNN's own false accepts (mismatch
+//! seed 2004, slow spin) from `tracking` into `unconfirmed` frames, for
+//! two `unconfirmed` frames after every correct acquisition.
 
 use nalgebra::{Rotation3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -56,6 +65,10 @@ pub struct VerifyConfig {
     pub max_angle_deg: f64,
     /// Two positions closer than this many bounding radii agree.
     pub max_offset_radii: f64,
+    /// Also verify a track of the chain's first method (the CNN), by
+    /// agreements only: nothing may replace it (measured harmful, see the
+    /// module), but it is published `unconfirmed` until confirmed.
+    pub confirm_first_method: bool,
 }
 
 impl Default for VerifyConfig {
@@ -66,6 +79,7 @@ impl Default for VerifyConfig {
             contradictions: 2,
             max_angle_deg: 10.0,
             max_offset_radii: 0.3,
+            confirm_first_method: true,
         }
     }
 }
@@ -191,14 +205,20 @@ impl Verifier {
         self.config.enabled
     }
 
+    /// Whether a track acquired by the method of rank `rank` in the chain
+    /// is verified (and published `unconfirmed` until confirmed).
+    pub fn verifies(&self, rank: usize) -> bool {
+        self.config.enabled && (rank > 0 || self.config.confirm_first_method)
+    }
+
     /// A new track, acquired by the method of rank `origin` in the chain
-    /// (0: the most trusted; None: not by the chain): unconfirmed, verified
-    /// from its next frame when a more trusted method exists.
-    pub fn reset(&mut self, origin: Option<usize>) {
+    /// (0: the most trusted; None: not by the chain) on frame `acquired_at`:
+    /// unconfirmed, verified from the next frame when [`Self::verifies`].
+    pub fn reset(&mut self, origin: Option<usize>, acquired_at: Option<u64>) {
         self.tracked.clear();
-        self.origin = origin.filter(|&rank| rank > 0);
+        self.origin = origin.filter(|&rank| self.verifies(rank));
         self.agreements = 0;
-        self.last = None;
+        self.last = acquired_at;
         self.contradiction = None;
     }
 

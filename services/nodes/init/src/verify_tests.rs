@@ -9,7 +9,7 @@ fn rx(deg: f64) -> Rotation3<f64> {
 fn verifier() -> Verifier {
     let group = vec![Rotation3::identity(), rx(120.0), rx(-120.0)];
     let mut v = Verifier::new(VerifyConfig::default(), group, 1.6);
-    v.reset(Some(1));
+    v.reset(Some(1), None);
     v
 }
 
@@ -65,12 +65,41 @@ fn each_frame_once_and_only_what_can_be_compared() {
     // A frame the tracker did not report as tracking.
     assert_eq!(v.on_result(5, Some((truth(5), 0))), Verdict::Unknown);
     assert!(!v.due(4) && v.due(6));
-    // A track of the most trusted method, or of no method of the chain, is
-    // not verified.
-    v.reset(Some(0));
+    // A track of no method of the chain is not verified.
+    v.reset(None, None);
     assert!(!v.due(0));
-    v.reset(None);
-    assert!(!v.due(0));
+    // A track is verified from the frame after its acquisition's.
+    v.reset(Some(1), Some(7));
+    assert!(!v.due(7) && v.due(8));
+}
+
+#[test]
+fn a_track_of_the_first_method_is_confirmed_by_agreements_and_never_replaced() {
+    let mut v = verifier();
+    v.reset(Some(0), None);
+    assert!(v.verifies(0) && v.due(0));
+    // Its own method contradicting it twice with one offset: no replacement.
+    track(&mut v, 0..4, rx(60.0));
+    for k in 0..2 {
+        assert_eq!(v.on_result(k, Some((truth(k), 0))), Verdict::Unknown);
+    }
+    assert!(
+        !v.confirmed() && v.due(2),
+        "still unconfirmed, still verified"
+    );
+    // Agreeing twice confirms it.
+    for k in 2..4 {
+        let verdict = v.on_result(k, Some((turned(truth(k), rx(60.0)), 0)));
+        assert_eq!(verdict, Verdict::Agrees { confirmed: k == 3 });
+    }
+    // Off by configuration: the first method's tracks are trusted.
+    let config = VerifyConfig {
+        confirm_first_method: false,
+        ..VerifyConfig::default()
+    };
+    let mut v = Verifier::new(config, vec![Rotation3::identity()], 1.6);
+    v.reset(Some(0), None);
+    assert!(!v.verifies(0) && v.verifies(1) && !v.due(0));
 }
 
 #[test]
@@ -140,7 +169,7 @@ fn disabled_nothing_is_due_and_bad_settings_are_named() {
         ..VerifyConfig::default()
     };
     let mut v = Verifier::new(off, vec![Rotation3::identity()], 1.0);
-    v.reset(Some(1));
+    v.reset(Some(1), None);
     assert!(!v.due(0));
     VerifyConfig::default().validate().unwrap();
     for (config, name) in [
