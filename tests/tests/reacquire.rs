@@ -116,7 +116,11 @@ fn the_suite_acquires_at_start_detects_the_loss_and_reacquires() {
                 format!(
                     "{} {} f_conv {:.2e} m² {:.0} ms",
                     AcquisitionMethod::from_u8(a.method).unwrap().as_str(),
-                    if a.success == 1 { "accepted" } else { "failed" },
+                    match (a.success, a.confirms()) {
+                        (_, Some(_)) => "confirmed",
+                        (1, None) => "accepted",
+                        _ => "failed",
+                    },
                     a.f_conv_m2,
                     a.time_ms
                 )
@@ -131,7 +135,7 @@ fn the_suite_acquires_at_start_detects_the_loss_and_reacquires() {
     let accepted: Vec<&AcquisitionResult> = acquisitions
         .iter()
         .map(|(a, _)| a)
-        .filter(|a| a.success == 1)
+        .filter(|a| a.success == 1 && a.confirms().is_none())
         .collect();
     // No truth anywhere: every result comes from the init service.
     for (a, _) in &acquisitions {
@@ -144,9 +148,11 @@ fn the_suite_acquires_at_start_detects_the_loss_and_reacquires() {
         .iter()
         .find(|a| a.sequence < LOOK_FIRST)
         .unwrap_or_else(|| panic!("no accepted acquisition before frame {LOOK_FIRST}"));
+    // Tracked (`unconfirmed` until init's second look agrees, then
+    // `tracking`).
     let first_tracked = seen
         .range(first.sequence + 1..LOOK_FIRST)
-        .find(|(_, (p, _))| status(p) == WireStatus::Tracking)
+        .find(|(_, (p, _))| status(p).is_tracked())
         .map(|(k, (_, at))| (*k, *at))
         .expect("no tracked frame after the first acquisition");
     println!(
@@ -207,12 +213,16 @@ fn the_suite_acquires_at_start_detects_the_loss_and_reacquires() {
     );
     let tracked_again = seen
         .range(again.sequence + 1..)
-        .filter(|(_, (p, _))| status(p) == WireStatus::Tracking)
+        .filter(|(_, (p, _))| status(p).is_tracked())
         .count();
     assert!(
         tracked_again >= 3,
         "{tracked_again} tracked frames after the reacquisition"
     );
+    let confirmed = seen
+        .range(again.sequence + 1..)
+        .any(|(_, (p, _))| status(p) == WireStatus::Tracking);
+    assert!(confirmed, "the reacquired track is never confirmed");
     // 4. Scored against the truth (only here, after the run): both
     //    acquisitions and every pose published `tracking` after them are
     //    right, up to deos's ±120° symmetry (d_sym, seed 004 Eq. 14).

@@ -88,6 +88,10 @@ pub struct PoseEstimate {
     pub iterations: u32,
     /// Sequence of the cloud frame this pose was computed from.
     pub sequence: u64,
+    /// With status `unconfirmed`: the frame of the acquisition whose
+    /// confirmation the track awaits (a restarted init service takes the
+    /// verification over from it); 0 otherwise.
+    pub acquisition_sequence: u64,
     /// Time of validity of the pose (s, sensor clock; the scan end).
     pub t_s: f64,
     /// Tracker instance that produced the estimate (e.g. `"tracker-a"`).

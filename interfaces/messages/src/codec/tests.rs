@@ -36,6 +36,7 @@ pub(super) fn pose_estimate(rng: &mut impl Rng) -> PoseEstimate {
         held_translations: rng.random_range(0..4),
         iterations: rng.random(),
         sequence: rng.random(),
+        acquisition_sequence: rng.random(),
         t_s: f(rng),
         instance: Name::new("tracker-a").unwrap(),
         q_sensor_target: arr(rng),

@@ -25,7 +25,7 @@ use crate::verify::{TrackedPose, Verdict, Verifier};
 use crate::worker::{Done, Frame, Worker};
 use spacepose_messages::{
     AcquisitionMethod, AcquisitionResult, Cloud, Message, Name, PoseEstimate, ServiceKind,
-    Verification, realtime_ns,
+    Verification, WireStatus, realtime_ns,
 };
 use spacepose_runtime::{Ctx, Flow, Node, NodeInfo};
 use std::time::Instant;
@@ -49,6 +49,8 @@ pub struct InitNode {
     verifying: bool,
     /// The published acquisition whose track awaits its confirmation.
     pending: Option<AcquisitionResult>,
+    /// The frame of the last acquisition confirmed.
+    confirmed: Option<u64>,
 }
 
 impl Node for InitNode {
@@ -143,6 +145,7 @@ impl InitNode {
             verifier: None,
             verifying: false,
             pending: None,
+            confirmed: None,
         })
     }
 
@@ -193,10 +196,13 @@ impl InitNode {
     /// Gives the verifier the tracker's `tracking` pose of a frame of the
     /// current track (not one started before the last hand-over).
     fn note_tracked(&mut self, e: &EstimateInfo, estimate: &PoseEstimate) {
+        let current = self.machine.of_current_track(e);
+        if current && e.status == WireStatus::Unconfirmed {
+            self.adopt(estimate);
+        }
         let Some(verifier) = &mut self.verifier else {
             return;
         };
-        let current = self.machine.of_current_track(e);
         let tracking = e.status.is_tracked() && self.machine.phase() == Phase::Tracking;
         if let (true, true, Ok(pose)) = (current, tracking, estimate.pose()) {
             verifier.on_tracked(TrackedPose {
@@ -204,6 +210,35 @@ impl InitNode {
                 t_sensor_target: pose,
             });
         }
+    }
+
+    /// An `unconfirmed` track this node does not know of (it was restarted
+    /// after the acquisition went out): its verification is taken over, by
+    /// agreements only (the method that acquired it is unknown), and
+    /// confirmed with the acquisition's frame the tracker names.
+    fn adopt(&mut self, estimate: &PoseEstimate) {
+        let acquired = estimate.acquisition_sequence;
+        let known = self.pending.is_some_and(|p| p.sequence == acquired);
+        let (Some(verifier), false) = (
+            &mut self.verifier,
+            known || self.confirmed == Some(acquired),
+        ) else {
+            return;
+        };
+        let (Some(&first), Ok(pose)) = (self.methods.first(), estimate.pose()) else {
+            return;
+        };
+        verifier.reset(Some(0), Some(acquired));
+        let mut msg = AcquisitionResult::new();
+        (msg.sequence, msg.t_s, msg.instance) = (acquired, estimate.t_s, self.instance);
+        (msg.method, msg.success) = (first as u8, 1);
+        msg.verification = Verification::Pending as u8;
+        msg.set_pose(&pose);
+        self.pending = Some(msg);
+        info!(
+            acquired,
+            "an unconfirmed track of an earlier acquisition: verifying it"
+        );
     }
 
     /// A verification finished: compared with the track; a track the
@@ -298,6 +333,7 @@ impl InitNode {
             return;
         };
         msg.verification = Verification::Confirms as u8;
+        self.confirmed = Some(msg.sequence);
         if ctx.send(&Message::Acquisition(msg)) {
             ctx.counters.frames_out += 1;
         }

@@ -162,3 +162,33 @@ fn a_fallback_track_two_verifications_agree_with_is_confirmed_once() {
     assert!(!h.node.busy());
     assert_eq!(h.counters.frames_out, 2);
 }
+
+/// A restarted init (it published nothing) hears a track `unconfirmed`
+/// since the acquisition of frame 3: it verifies it and confirms frame 3's
+/// acquisition, once.
+#[test]
+fn a_restarted_init_takes_over_the_verification_of_an_unconfirmed_track() {
+    let truth = truth();
+    let mut h = verifying_node(vec![Some(truth)], vec![None]);
+    let points = vec![Point::new(0.0, 0.0, 15.0, 1.0, 0.0); 5];
+    let unconfirmed_at = |sequence| {
+        let mut e = tracking_at(sequence, &truth);
+        e.status = WireStatus::Unconfirmed as u8;
+        e.acquisition_sequence = 3;
+        e
+    };
+    for k in [5, 6] {
+        h.estimate(unconfirmed_at(k));
+        assert!(h.cloud(k, &points).is_empty());
+        assert!(h.node.busy(), "frame {k} is verified");
+    }
+    let confirms = h.finished();
+    assert_eq!(confirms.confirms(), Some(3), "{confirms:?}");
+    assert_eq!(confirms.method, AcquisitionMethod::Cnn as u8);
+    // The tracker's next frame, computed before the confirmation reached
+    // it, is still `unconfirmed`: nothing is verified again.
+    h.estimate(unconfirmed_at(7));
+    assert!(h.cloud(7, &points).is_empty());
+    assert!(!h.node.busy());
+    assert_eq!(h.counters.frames_out, 1);
+}

@@ -234,8 +234,9 @@ impl TrackerNode {
             None => self.track.fill_prediction(&mut result, header.scan_end_s),
         }
         let tracking = result.estimate.status == WireStatus::Tracking as u8;
-        if tracking && self.unconfirmed.is_some() {
+        if let (true, Some(acquired)) = (tracking, self.unconfirmed) {
             result.estimate.status = WireStatus::Unconfirmed as u8;
+            result.estimate.acquisition_sequence = acquired;
         }
         result
     }

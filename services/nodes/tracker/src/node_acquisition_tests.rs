@@ -143,10 +143,12 @@ fn a_pending_acquisition_is_tracked_unconfirmed_until_its_own_confirmation() {
         TrackerNode::with_model(config, fixture().model.clone(), instance, 150_000).unwrap();
     let mut pending = truth_acquisition(&f[0]);
     pending.verification = Verification::Pending as u8;
+    pending.sequence = 4;
     assert!(node.on_acquisition(&pending).unwrap());
     assert!(node.is_unconfirmed());
     let r = node.track_frame(&header(0, &f[0]), &f[0].points);
     assert_eq!(status(&r), WireStatus::Unconfirmed, "{}", r.reason);
+    assert_eq!(r.estimate.acquisition_sequence, pending.sequence);
     // A confirmation of another acquisition changes nothing, and restarts
     // nothing.
     let mut other = pending;

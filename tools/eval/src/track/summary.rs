@@ -26,19 +26,21 @@ pub struct TrackSummary {
     pub frames_skipped: usize,
     /// Frames whose point times were derived (no time field).
     pub frames_derived_times: usize,
-    /// Frames published `tracking`, `degraded`, `lost`.
+    /// Frames published `tracking`, `degraded`, `lost`, `unconfirmed`.
     pub tracking: usize,
     /// See `tracking`.
     pub degraded: usize,
     /// See `tracking`.
     pub lost: usize,
+    /// See `tracking` (tracked, the acquisition not yet verified).
+    pub unconfirmed: usize,
     /// Every acquisition, in order.
     pub acquisitions: Vec<AcquisitionRecord>,
     /// The acquisitions by verdict.
     pub acquisition_counts: AcquisitionCounts,
     /// Tracker time per frame (ms).
     pub time_ms: MeanMax,
-    /// Errors of the `tracking` and `degraded` frames, when the recording
+    /// Errors of the frames with a pose (not `lost`), when the recording
     /// has truth.
     pub errors: Option<Errors>,
 }
@@ -46,7 +48,7 @@ pub struct TrackSummary {
 /// Errors against the truth.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct Errors {
-    /// Frames scored (published `tracking` or `degraded`, truth known).
+    /// Frames scored (published with a pose, not `lost`; truth known).
     pub frames_scored: usize,
     /// Attitude error (deg, d_sym over the target's symmetry group).
     pub ang_err_deg: MeanMax,
@@ -96,6 +98,7 @@ impl<'a> Scorer<'a> {
         match status {
             "tracking" => self.summary.tracking += 1,
             "degraded" => self.summary.degraded += 1,
+            "unconfirmed" => self.summary.unconfirmed += 1,
             _ => {
                 self.summary.lost += 1;
                 return;
@@ -136,9 +139,10 @@ impl TrackSummary {
     /// The lines printed at the end.
     pub fn render(&self) -> String {
         let mut s = format!(
-            "{} frames: {} tracking, {} degraded, {} lost; tracker {:.1} ms mean, {:.1} ms max\n",
+            "{} frames: {} tracking, {} unconfirmed, {} degraded, {} lost; tracker {:.1} ms mean, {:.1} ms max\n",
             self.frames,
             self.tracking,
+            self.unconfirmed,
             self.degraded,
             self.lost,
             self.time_ms.mean,
