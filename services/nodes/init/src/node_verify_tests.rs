@@ -40,6 +40,26 @@ fn tracking_at(sequence: u64, pose: &Pose) -> PoseEstimate {
     e
 }
 
+/// The tracker's `unconfirmed` estimate of `sequence` at `pose`, its track
+/// awaiting the confirmation of the acquisition of frame `acquired`.
+fn unconfirmed_at(sequence: u64, pose: &Pose, acquired: u64) -> PoseEstimate {
+    let mut e = tracking_at(sequence, pose);
+    e.status = WireStatus::Unconfirmed as u8;
+    e.acquisition_sequence = acquired;
+    e
+}
+
+/// The tracker's `estimate` of each frame, then the frame: each one is
+/// looked at (a verification runs after it).
+fn looked_at(h: &mut Harness, frames: [u64; 2], estimate: impl Fn(u64) -> PoseEstimate) {
+    let points = vec![Point::new(0.0, 0.0, 15.0, 1.0, 0.0); 5];
+    for k in frames {
+        h.estimate(estimate(k));
+        assert!(h.cloud(k, &points).is_empty());
+        assert!(h.node.busy(), "frame {k} is verified");
+    }
+}
+
 /// A node whose chain is the CNN then template matching, each scripted,
 /// verifying with the defaults on deos.
 fn verifying_node(cnn: Vec<Option<Pose>>, tm: Vec<Option<Pose>>) -> Harness {
@@ -117,11 +137,7 @@ fn a_fallback_track_the_cnn_contradicts_twice_is_replaced() {
     assert!(deg < 1e-9 && m < 1e-9, "{deg} deg, {m} m");
     assert!(matches!(h.node.phase(), Phase::HandedOver { frame: 2, .. }));
     // The CNN's own track: two agreements confirm it.
-    for k in [3, 4] {
-        h.estimate(tracking_at(k, &truth));
-        assert!(h.cloud(k, &points).is_empty());
-        assert!(h.node.busy(), "frame {k} is verified");
-    }
+    looked_at(&mut h, [3, 4], |k| tracking_at(k, &truth));
     let confirms = h.finished();
     assert_eq!(confirms.confirms(), Some(2), "{confirms:?}");
     assert_eq!(h.counters.frames_out, 3, "verifications are not published");
@@ -140,16 +156,7 @@ fn a_fallback_track_two_verifications_agree_with_is_confirmed_once() {
     h.estimate(tracker(0, WireStatus::Lost, NOW_NS));
     let first = h.finished();
     assert!(first.pending());
-    let unconfirmed_at = |sequence| {
-        let mut e = tracking_at(sequence, &truth);
-        e.status = WireStatus::Unconfirmed as u8;
-        e
-    };
-    for k in [1, 2] {
-        h.estimate(unconfirmed_at(k));
-        assert!(h.cloud(k, &points).is_empty());
-        assert!(h.node.busy(), "frame {k} is verified");
-    }
+    looked_at(&mut h, [1, 2], |k| unconfirmed_at(k, &truth, 0));
     let confirms = h.finished();
     assert_eq!(confirms.confirms(), Some(0), "{confirms:?}");
     assert_eq!(
@@ -171,23 +178,13 @@ fn a_restarted_init_takes_over_the_verification_of_an_unconfirmed_track() {
     let truth = truth();
     let mut h = verifying_node(vec![Some(truth)], vec![None]);
     let points = vec![Point::new(0.0, 0.0, 15.0, 1.0, 0.0); 5];
-    let unconfirmed_at = |sequence| {
-        let mut e = tracking_at(sequence, &truth);
-        e.status = WireStatus::Unconfirmed as u8;
-        e.acquisition_sequence = 3;
-        e
-    };
-    for k in [5, 6] {
-        h.estimate(unconfirmed_at(k));
-        assert!(h.cloud(k, &points).is_empty());
-        assert!(h.node.busy(), "frame {k} is verified");
-    }
+    looked_at(&mut h, [5, 6], |k| unconfirmed_at(k, &truth, 3));
     let confirms = h.finished();
     assert_eq!(confirms.confirms(), Some(3), "{confirms:?}");
     assert_eq!(confirms.method, AcquisitionMethod::Cnn as u8);
     // The tracker's next frame, computed before the confirmation reached
     // it, is still `unconfirmed`: nothing is verified again.
-    h.estimate(unconfirmed_at(7));
+    h.estimate(unconfirmed_at(7, &truth, 3));
     assert!(h.cloud(7, &points).is_empty());
     assert!(!h.node.busy());
     assert_eq!(h.counters.frames_out, 1);
