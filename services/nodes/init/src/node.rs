@@ -213,9 +213,11 @@ impl InitNode {
     }
 
     /// An `unconfirmed` track this node does not know of (it was restarted
-    /// after the acquisition went out): its verification is taken over, by
-    /// agreements only (the method that acquired it is unknown), and
-    /// confirmed with the acquisition's frame the tracker names.
+    /// after the acquisition went out): its verification is taken over and
+    /// confirmed with the acquisition's frame the tracker names. The method
+    /// that acquired it is unknown: it counts as the most trusted one whose
+    /// tracks are verified (with `confirm_first_method`, the first: by
+    /// agreements only).
     fn adopt(&mut self, estimate: &PoseEstimate) {
         let acquired = estimate.acquisition_sequence;
         let known = self.pending.is_some_and(|p| p.sequence == acquired);
@@ -225,13 +227,14 @@ impl InitNode {
         ) else {
             return;
         };
-        let (Some(&first), Ok(pose)) = (self.methods.first(), estimate.pose()) else {
+        let origin = (0..self.methods.len()).find(|&rank| verifier.verifies(rank));
+        let (Some(origin), Ok(pose)) = (origin, estimate.pose()) else {
             return;
         };
-        verifier.reset(Some(0), Some(acquired));
+        verifier.reset(Some(origin), Some(acquired));
         let mut msg = AcquisitionResult::new();
         (msg.sequence, msg.t_s, msg.instance) = (acquired, estimate.t_s, self.instance);
-        (msg.method, msg.success) = (first as u8, 1);
+        (msg.method, msg.success) = (self.methods[origin] as u8, 1);
         msg.verification = Verification::Pending as u8;
         msg.set_pose(&pose);
         self.pending = Some(msg);
