@@ -53,10 +53,10 @@ impl AcquisitionMethod {
 #[repr(u8)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum Verification {
-    /// The method is trusted (the chain's first, the truth, a given pose):
+    /// Not verified (the truth, a given pose, or init's verification off):
     /// the track it starts is `tracking` at once.
     Trusted = 0,
-    /// A fallback method acquired: the track it starts is published
+    /// Init will verify it: the track it starts is published
     /// `unconfirmed` until a record with [`Verification::Confirms`] for
     /// this acquisition's frame follows (or a new acquisition replaces it).
     Pending = 1,

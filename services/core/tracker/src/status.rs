@@ -22,7 +22,7 @@ pub enum TrackStatus {
     /// As `Tracking`, but the acquisition that started the track awaits
     /// its verification. Never from [`crate::Tracker`] itself: the tracker
     /// service publishes its `Tracking` frames so while the init service
-    /// has not confirmed a fallback method's acquisition (wire
+    /// has not confirmed the track's acquisition (wire
     /// `Verification::Pending`, `docs/design/acquisition-verification.md`).
     Unconfirmed,
 }

@@ -11,7 +11,7 @@
 //! first frame with enough points after the gap.
 //!
 //! A track started by an acquisition that awaits its verification
-//! (`Verification::Pending`: a fallback method acquired it) is published
+//! (`Verification::Pending`: init looks again before it confirms it) is published
 //! `unconfirmed` instead of `tracking` until the init service's record
 //! that confirms that acquisition arrives; everything else is the same
 //! (the filter fuses it).

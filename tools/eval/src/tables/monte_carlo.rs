@@ -121,8 +121,8 @@ pub fn table(reports: &[(String, Report)]) -> String {
          max over the seeds. Acquisitions: correct / false accepts / rejected, summed over \
          the seeds (a false accept is an accepted pose more than 10° or 50 cm off). \
          Silent: frames published `tracking` more than 10° or 50 cm off; unconfirmed: \
-         frames published `unconfirmed` (a fallback method's acquisition awaiting its \
-         verification), with those of them that far off. \
+         frames published `unconfirmed` (the acquisition awaiting its verification \
+         by a second look), with those of them that far off. \
          Consistency: each run's median NEES of the published pose and of the filter's \
          posterior, and its median NIS, averaged over the seeds (χ²(6) median 5.3).\n\n",
     );

@@ -40,8 +40,8 @@ pub struct SeedFigures {
     pub diverged: usize,
     /// Frames published as `tracking` while more than 10° or 50 cm off.
     pub silent: usize,
-    /// Frames published `unconfirmed` (a fallback method's acquisition
-    /// awaiting its verification).
+    /// Frames published `unconfirmed` (the acquisition awaiting its
+    /// confirmation by a second look).
     pub unconfirmed: usize,
     /// Of those, frames more than 10° or 50 cm off.
     pub unconfirmed_far_off: usize,

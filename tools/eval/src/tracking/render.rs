@@ -156,7 +156,7 @@ fn notes(report: &TrackingReport) -> String {
         }
         if m.unconfirmed_frames > 0 {
             s += &format!(
-                "{name}: {} frames unconfirmed (a fallback method's acquisition not yet verified)\n",
+                "{name}: {} frames unconfirmed (the acquisition not yet confirmed by a second look)\n",
                 m.unconfirmed_frames
             );
         }
