@@ -8,7 +8,7 @@
 //! the next wanted one; while one runs the node asks to be woken every
 //! [`BUSY_POLL_NS`].
 //!
-//! While the suite tracks a pose a fallback method acquired and no
+//! While the suite tracks an acquired pose not yet confirmed and no
 //! acquisition is wanted, the worker verifies the track
 //! ([`crate::verify`]): it acquires on a copy of the held frame, and the
 //! result is compared with the tracker's pose of that frame instead of

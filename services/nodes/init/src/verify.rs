@@ -1,10 +1,11 @@
 //! The verification of a hand-over (issue 25 item 4, "no silent wrong
-//! pose"; not in the papers): while the suite tracks a pose that a
-//! fallback method acquired (template matching, after the CNN rejected its
-//! poses), the init service runs its method chain again on the following
-//! frames and compares each accepted pose with the tracker's pose of the
-//! same frame. Agreements confirm the track; contradictions by a method
-//! the chain trusts more, that agree with each other, replace it.
+//! pose"; not in the papers): while the suite tracks an acquired pose,
+//! the init service runs its method chain again on the following frames
+//! and compares each accepted pose with the tracker's pose of the same
+//! frame. Agreements confirm the track; contradictions by a method the
+//! chain trusts more than the one that acquired it (template matching,
+//! after the CNN rejected its poses), that agree with each other, replace
+//! it.
 //!
 //! Why: with the facility's clutter, development seeds 2002, 2003, 2005
 //! and 2006, template matching accepted poses 22-51° off on the detection's
@@ -37,7 +38,7 @@
 //! seed 2004, slow spin) from `tracking` into `unconfirmed` frames, for
 //! two `unconfirmed` frames after every correct acquisition.
 
-use nalgebra::{Rotation3, Vector3};
+use nalgebra::Rotation3;
 use serde::{Deserialize, Serialize};
 use spacepose_geometry::{Pose, so3};
 use std::collections::VecDeque;
@@ -142,29 +143,11 @@ pub enum Verdict {
     },
 }
 
-/// A contradiction: the pose's offset from the track in the body frame.
-#[derive(Debug, Clone, Copy)]
-struct Offset {
-    rotation: Rotation3<f64>,
-    translation_target: Vector3<f64>,
-}
-
-impl Offset {
-    /// The offset of `pose` from `track`, in the track's body frame.
-    fn of(track: &Pose, pose: &Pose) -> Offset {
-        Offset {
-            rotation: track.rotation.transpose() * pose.rotation,
-            translation_target: track.rotation.transpose() * (pose.translation - track.translation),
-        }
-    }
-
-    /// The offset from this one to `other`.
-    fn to(&self, other: &Offset) -> Offset {
-        Offset {
-            rotation: self.rotation.transpose() * other.rotation,
-            translation_target: other.translation_target - self.translation_target,
-        }
-    }
+/// The offset of `pose` from `track` in the track's body frame
+/// (`track⁻¹ ∘ pose`); between two offsets, likewise (`a⁻¹ ∘ b`, whose
+/// translation has the length of the offsets' difference).
+fn body_offset(track: &Pose, pose: &Pose) -> Pose {
+    track.inverse().compose(pose)
 }
 
 /// The verification state of the current track.
@@ -181,7 +164,7 @@ pub struct Verifier {
     /// The newest frame verified (each frame is verified at most once).
     last: Option<u64>,
     /// The pending contradiction: its offset, its frame, how many in a row.
-    contradiction: Option<(Offset, u64, u32)>,
+    contradiction: Option<(Pose, u64, u32)>,
 }
 
 impl Verifier {
@@ -253,7 +236,7 @@ impl Verifier {
         else {
             return Verdict::Unknown;
         };
-        let offset = Offset::of(&track.t_sensor_target, &pose);
+        let offset = body_offset(&track.t_sensor_target, &pose);
         if self.small(&offset) {
             self.agreements += 1;
             self.contradiction = None;
@@ -267,7 +250,8 @@ impl Verifier {
         }
         let in_a_row = match self.contradiction {
             Some((before, at, n))
-                if sequence <= at + MAX_CONTRADICTION_GAP && self.small(&before.to(&offset)) =>
+                if sequence <= at + MAX_CONTRADICTION_GAP
+                    && self.small(&body_offset(&before, &offset)) =>
             {
                 n + 1
             }
@@ -290,9 +274,9 @@ impl Verifier {
     }
 
     /// Within the agreement bounds.
-    fn small(&self, o: &Offset) -> bool {
+    fn small(&self, o: &Pose) -> bool {
         self.angle(&o.rotation) <= self.config.max_angle_deg.to_radians()
-            && o.translation_target.norm() <= self.config.max_offset_radii * self.radius_m
+            && o.translation.norm() <= self.config.max_offset_radii * self.radius_m
     }
 }
 

@@ -1,4 +1,5 @@
 use super::*;
+use nalgebra::Vector3;
 
 fn rx(deg: f64) -> Rotation3<f64> {
     Rotation3::from_axis_angle(&Vector3::x_axis(), deg.to_radians())

@@ -139,8 +139,8 @@ pub struct ModeReport {
     pub lost_frames: usize,
     /// Frames the tracker reported degraded.
     pub degraded_frames: usize,
-    /// Frames the tracker published `unconfirmed` (a fallback method's
-    /// acquisition awaiting its verification).
+    /// Frames the tracker published `unconfirmed` (the acquisition
+    /// awaiting its confirmation by a second look).
     pub unconfirmed_frames: usize,
     /// Frames whose true error exceeded 10° or 50 cm (including lost ones).
     pub diverged_frames: usize,
