@@ -16,6 +16,16 @@ pub fn status_to_wire(status: TrackStatus) -> WireStatus {
     }
 }
 
+/// The track status of a wire code ([`status_to_wire`] back).
+pub fn status_from_wire(status: WireStatus) -> TrackStatus {
+    match status {
+        WireStatus::Tracking => TrackStatus::Tracking,
+        WireStatus::Degraded => TrackStatus::Degraded,
+        WireStatus::Lost => TrackStatus::Lost,
+        WireStatus::Unconfirmed => TrackStatus::Unconfirmed,
+    }
+}
+
 /// An estimate for the frame of `header`, status `lost`, identity pose:
 /// the starting point of every published estimate (`published_ns` is
 /// stamped by the publisher).
@@ -83,8 +93,10 @@ mod tests {
             TrackStatus::Tracking,
             TrackStatus::Degraded,
             TrackStatus::Lost,
+            TrackStatus::Unconfirmed,
         ] {
             assert_eq!(status_to_wire(s).as_str(), s.as_str());
+            assert_eq!(status_from_wire(status_to_wire(s)), s);
         }
     }
 

@@ -7,8 +7,9 @@ use nalgebra::Rotation3;
 use serde::Serialize;
 use spacepose_geometry::Pose;
 use spacepose_lidar_sim::Frame;
-use spacepose_messages::{PoseEstimate, WireStatus};
+use spacepose_messages::PoseEstimate;
 use spacepose_tracker::{TrackOutput, TrackStatus};
+use spacepose_tracker_node::wire::status_from_wire;
 use std::collections::BTreeMap;
 
 pub use super::bounds::{DIVERGED_DEG, DIVERGED_M};
@@ -243,12 +244,10 @@ pub fn record(
     out: Option<&TrackOutput>,
     symmetries: &[Rotation3<f64>],
 ) -> FrameRecord {
-    let status = match estimate.wire_status() {
-        Ok(WireStatus::Tracking) => TrackStatus::Tracking,
-        Ok(WireStatus::Degraded) => TrackStatus::Degraded,
-        Ok(WireStatus::Unconfirmed) => TrackStatus::Unconfirmed,
-        _ => TrackStatus::Lost,
-    };
+    // An unknown code reads `lost`.
+    let status = estimate
+        .wire_status()
+        .map_or(TrackStatus::Lost, status_from_wire);
     let pose = estimate.pose().ok().filter(|_| status != TrackStatus::Lost);
     let truth = &frame.truth;
     let (ang, pos) = pose.map_or((f64::NAN, f64::NAN), |p: Pose| {
