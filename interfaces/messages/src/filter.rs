@@ -26,8 +26,12 @@ pub struct FilterState {
     pub v_sensor: [f64; 3],
     /// Angular velocity of the target relative to the sensor, in the target body frame (rad/s).
     pub w_target: [f64; 3],
-    /// Covariance of the attitude state `[rot (rad); ω (rad/s)]`, row major.
-    pub attitude_covariance: [[f64; 6]; 6],
+    /// Angular velocity of the sensor frame w.r.t. inertial space, in the
+    /// sensor frame (rad/s): the chaser's turn as the filter estimates it.
+    pub w_inertial_sensor: [f64; 3],
+    /// Covariance of the attitude state `[rot (rad); w_target (rad/s);
+    /// w_inertial_sensor (rad/s)]`, row major.
+    pub attitude_covariance: [[f64; 9]; 9],
     /// Covariance of the position state `[p (m); v (m/s)]`, row major.
     pub position_covariance: [[f64; 6]; 6],
     /// CLOCK_REALTIME at send (ns since the Unix epoch).

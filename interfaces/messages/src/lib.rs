@@ -45,4 +45,4 @@ pub use truth::TruthMsg;
 pub use iceoryx2::prelude::ZeroCopySend;
 
 /// Version of the wire schema (the codec envelope and every `schema` field).
-pub const SCHEMA_VERSION: u16 = 6;
+pub const SCHEMA_VERSION: u16 = 7;

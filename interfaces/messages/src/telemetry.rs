@@ -39,7 +39,7 @@ fn euler_deg(q: &[f64; 4]) -> Result<[f64; 3], MessageError> {
     Ok(Euler321::from_rotation(&rotation_from_wxyz(q)?).to_degrees())
 }
 
-fn sigmas(cov: &[[f64; 6]; 6], start: usize, scale: f64) -> [f64; 3] {
+fn sigmas<const N: usize>(cov: &[[f64; N]; N], start: usize, scale: f64) -> [f64; 3] {
     std::array::from_fn(|i| cov[start + i][start + i].max(0.0).sqrt() * scale)
 }
 

@@ -23,7 +23,7 @@ fn unit_quaternion(rng: &mut impl Rng) -> [f64; 4] {
     q.map(|v| v / n)
 }
 
-fn cov(rng: &mut impl Rng) -> [[f64; 6]; 6] {
+fn cov<const N: usize>(rng: &mut impl Rng) -> [[f64; N]; N] {
     std::array::from_fn(|_| arr(rng))
 }
 
@@ -63,6 +63,7 @@ pub(super) fn filter_state(rng: &mut impl Rng) -> FilterState {
         p_sensor_target: arr(rng),
         v_sensor: arr(rng),
         w_target: arr(rng),
+        w_inertial_sensor: arr(rng),
         attitude_covariance: cov(rng),
         position_covariance: cov(rng),
         published_ns: rng.random(),

@@ -2,11 +2,15 @@
 //! `spacepose-messages` (`FilterState`, `PoseEstimate`, `AcquisitionResult`).
 //!
 //! The `FilterState` carries the full state of [`RelativeMotionFilter`]
-//! (pose, `v_sensor`, `w_target` and both 6x6 covariances), so a tracker can
+//! (pose, `v_sensor`, `w_target`, `w_inertial_sensor`, the 9x9 attitude and
+//! 6x6 position covariances), so a tracker can
 //! [`RelativeMotionFilter::restore`] it and predict to any time itself
 //! (seed 000 Eq. 8-9).
 
-use super::{matrix6_from_wire, matrix6_to_wire, vector3_from_wire, vector3_to_wire};
+use super::{
+    matrix_from_wire, matrix_to_wire, matrix6_from_wire, matrix6_to_wire, vector3_from_wire,
+    vector3_to_wire,
+};
 use crate::error::MessageError;
 use crate::{AcquisitionResult, FilterState, PoseEstimate, WireStatus};
 use nalgebra::{Matrix6, Vector3};
@@ -48,7 +52,8 @@ pub fn state_from_prediction(p: &Prediction, sequence: u64) -> FilterState {
     s.set_pose(&p.pose);
     s.v_sensor = vector3_to_wire(&p.v_sensor);
     s.w_target = vector3_to_wire(&p.w_target);
-    s.attitude_covariance = matrix6_to_wire(&p.attitude_covariance);
+    s.w_inertial_sensor = vector3_to_wire(&p.w_inertial_sensor);
+    s.attitude_covariance = matrix_to_wire(&p.attitude_covariance);
     s.position_covariance = matrix6_to_wire(&p.position_covariance);
     s
 }
@@ -75,14 +80,15 @@ pub fn prediction_from_state(s: &FilterState) -> Result<Option<Prediction>, Mess
         return Err(invalid(WHAT, "time is not finite"));
     }
     let pose = s.pose().map_err(|e| invalid(WHAT, e))?;
-    let covs = [&s.attitude_covariance, &s.position_covariance];
     if !finite(&s.v_sensor)
         || !finite(&s.w_target)
-        || !covs.iter().all(|c| finite(c.as_flattened()))
+        || !finite(&s.w_inertial_sensor)
+        || !finite(s.attitude_covariance.as_flattened())
+        || !finite(s.position_covariance.as_flattened())
     {
         return Err(invalid(WHAT, "non-finite velocity or covariance"));
     }
-    let attitude_covariance = matrix6_from_wire(&s.attitude_covariance);
+    let attitude_covariance = matrix_from_wire(&s.attitude_covariance);
     let position_covariance = matrix6_from_wire(&s.position_covariance);
     let mut covariance = Matrix6::zeros();
     covariance
@@ -96,6 +102,7 @@ pub fn prediction_from_state(s: &FilterState) -> Result<Option<Prediction>, Mess
         pose,
         v_sensor: vector3_from_wire(&s.v_sensor),
         w_target: vector3_from_wire(&s.w_target),
+        w_inertial_sensor: vector3_from_wire(&s.w_inertial_sensor),
         covariance,
         attitude_covariance,
         position_covariance,

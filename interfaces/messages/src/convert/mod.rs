@@ -18,7 +18,7 @@ pub use filter::{
 };
 
 use crate::error::MessageError;
-use nalgebra::{Matrix6, Quaternion, Rotation3, UnitQuaternion, Vector3};
+use nalgebra::{Matrix6, Quaternion, Rotation3, SMatrix, UnitQuaternion, Vector3};
 use spacepose_geometry::Pose;
 
 /// Largest accepted deviation of a received quaternion's norm from 1.
@@ -74,7 +74,17 @@ pub fn vector3_from_wire(v: &[f64; 3]) -> Vector3<f64> {
 
 /// A 6x6 matrix as row-major arrays.
 pub fn matrix6_to_wire(m: &Matrix6<f64>) -> [[f64; 6]; 6] {
-    let mut out = [[0.0; 6]; 6];
+    matrix_to_wire(m)
+}
+
+/// Row-major arrays as a 6x6 matrix.
+pub fn matrix6_from_wire(m: &[[f64; 6]; 6]) -> Matrix6<f64> {
+    matrix_from_wire(m)
+}
+
+/// A square matrix as row-major arrays.
+pub fn matrix_to_wire<const N: usize>(m: &SMatrix<f64, N, N>) -> [[f64; N]; N] {
+    let mut out = [[0.0; N]; N];
     for (r, row) in out.iter_mut().enumerate() {
         for (c, v) in row.iter_mut().enumerate() {
             *v = m[(r, c)];
@@ -83,9 +93,9 @@ pub fn matrix6_to_wire(m: &Matrix6<f64>) -> [[f64; 6]; 6] {
     out
 }
 
-/// Row-major arrays as a 6x6 matrix.
-pub fn matrix6_from_wire(m: &[[f64; 6]; 6]) -> Matrix6<f64> {
-    Matrix6::from_fn(|r, c| m[r][c])
+/// Row-major arrays as a square matrix.
+pub fn matrix_from_wire<const N: usize>(m: &[[f64; N]; N]) -> SMatrix<f64, N, N> {
+    SMatrix::from_fn(|r, c| m[r][c])
 }
 
 #[cfg(test)]

@@ -20,6 +20,20 @@ pub struct FilterConfig {
     /// once these were given their real weight
     /// (`docs/design/measurement-covariance.md`).
     pub q_w: f64,
+    /// Estimate the sensor frame's own angular velocity `Ω` beside the
+    /// target's (`crate::attitude`; `docs/design/sensor-frame-rate.md`).
+    /// Off: seed 000's constant relative rate (Eq. 9).
+    pub sensor_rate: bool,
+    /// Random-walk density of the sensor frame's angular velocity
+    /// (rad²/s³). 1e-6: the fly-around turns the chaser by up to about
+    /// 2-3°/s and changes that turn over tens of seconds (≈ 3e-4 rad/s²,
+    /// whose square is 1e-7); ten times that follows a change within a few
+    /// frames.
+    pub q_w_sensor: f64,
+    /// Initial uncertainty of the sensor frame's angular velocity, per axis
+    /// (deg/s, 1σ; it starts at 0): a chaser keeping a target in view turns
+    /// at a few degrees a second at most.
+    pub initial_sigma_w_sensor_degps: f64,
     /// Fixed attitude measurement noise, per axis (deg, 1σ).
     pub sigma_rot_deg: f64,
     /// Fixed position measurement noise, per axis (m, 1σ).
@@ -60,6 +74,9 @@ impl Default for FilterConfig {
             q_pos: 1e-4,
             q_rot: 1e-6,
             q_w: 3e-5,
+            sensor_rate: true,
+            q_w_sensor: 1e-6,
+            initial_sigma_w_sensor_degps: 2.0,
             sigma_rot_deg: 1.0,
             sigma_pos_m: 0.02,
             use_registration_covariance: true,
@@ -83,6 +100,7 @@ impl FilterConfig {
             ("q_pos", self.q_pos),
             ("q_rot", self.q_rot),
             ("q_w", self.q_w),
+            ("q_w_sensor", self.q_w_sensor),
         ];
         for (name, v) in non_negative {
             if !v.is_finite() || v < 0.0 {
@@ -102,6 +120,10 @@ impl FilterConfig {
             ("initial_sigma_pos_m", self.initial_sigma_pos_m),
             ("initial_sigma_v_mps", self.initial_sigma_v_mps),
             ("initial_sigma_w_degps", self.initial_sigma_w_degps),
+            (
+                "initial_sigma_w_sensor_degps",
+                self.initial_sigma_w_sensor_degps,
+            ),
             (
                 "gate_mahalanobis2",
                 self.gate_mahalanobis2
@@ -167,6 +189,14 @@ mod tests {
             },
             FilterConfig {
                 initial_sigma_w_degps: f64::INFINITY,
+                ..Default::default()
+            },
+            FilterConfig {
+                q_w_sensor: f64::NAN,
+                ..Default::default()
+            },
+            FilterConfig {
+                initial_sigma_w_sensor_degps: 0.0,
                 ..Default::default()
             },
         ];

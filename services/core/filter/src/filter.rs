@@ -10,41 +10,17 @@
 //! [`RelativeMotionFilter::update`]; [`RelativeMotionFilter::predict_at`]
 //! propagates a copy to any time at or after the last update.
 
-use crate::attitude::AttitudeFilter;
+use crate::attitude::{AttitudeFilter, AttitudeNoise, Matrix9};
 use crate::config::FilterConfig;
 use crate::error::FilterError;
 use crate::kalman::checked_covariance3;
+pub use crate::kalman::covariance_from_information;
 use crate::position::PositionFilter;
 use nalgebra::{Matrix3, Matrix6, Vector3};
 use spacepose_geometry::Pose;
 
 // The outputs keep their old path, `spacepose_filter::filter::*`.
 pub use crate::outputs::{Prediction, UpdateOutcome};
-
-/// The registration's covariance from its information matrix (6x6,
-/// `δ = [rot; trans]`, left-⊕ of Eq. 5): `Σ = Λ⁻¹`. Fails when `Λ` is not
-/// finite, symmetric and positive definite (e.g. a degenerate geometry).
-pub fn covariance_from_information(
-    information: &Matrix6<f64>,
-) -> Result<Matrix6<f64>, FilterError> {
-    let what = "registration information matrix";
-    if !information.iter().all(|v| v.is_finite()) {
-        return Err(FilterError::NonFinite { what });
-    }
-    if (information - information.transpose()).abs().max() > 1e-9 * information.abs().max() {
-        return Err(FilterError::NotPositiveDefinite { what });
-    }
-    let sym = (information + information.transpose()) * 0.5;
-    let chol = sym
-        .cholesky()
-        .ok_or(FilterError::NotPositiveDefinite { what })?;
-    let inv = chol.inverse();
-    let inv = (inv + inv.transpose()) * 0.5;
-    if !inv.iter().all(|v| v.is_finite()) {
-        return Err(FilterError::NotPositiveDefinite { what });
-    }
-    Ok(inv)
-}
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct State {
@@ -125,12 +101,22 @@ impl RelativeMotionFilter {
         }
         let c = &self.config;
         let p_pos = diag6(c.initial_sigma_pos_m, c.initial_sigma_v_mps);
-        let p_att = diag6(
-            c.initial_sigma_rot_deg.to_radians(),
-            c.initial_sigma_w_degps.to_radians(),
-        );
+        let mut p_att = Matrix9::zeros();
+        for i in 0..3 {
+            p_att[(i, i)] = c.initial_sigma_rot_deg.to_radians().powi(2);
+            p_att[(i + 3, i + 3)] = c.initial_sigma_w_degps.to_radians().powi(2);
+            p_att[(i + 6, i + 6)] = c.initial_sigma_w_sensor_degps.to_radians().powi(2);
+        }
         let position = PositionFilter::new(t_sensor_target.translation, v_sensor, p_pos)?;
-        let attitude = AttitudeFilter::new(t_sensor_target.rotation, w_target, p_att)?;
+        // The sensor frame's rate starts at 0: the given rate is all the
+        // target's (ω = u).
+        let attitude = AttitudeFilter::new(
+            t_sensor_target.rotation,
+            w_target,
+            Vector3::zeros(),
+            p_att,
+            c.sensor_rate,
+        )?;
         self.state = Some(State {
             t,
             position,
@@ -159,7 +145,9 @@ impl RelativeMotionFilter {
         let attitude = AttitudeFilter::new(
             state.pose.rotation,
             state.w_target,
+            state.w_inertial_sensor,
             state.attitude_covariance,
+            self.config.sensor_rate,
         )?;
         self.state = Some(State {
             t: state.t,
@@ -197,7 +185,14 @@ impl RelativeMotionFilter {
         Ok(State {
             t,
             position: s.position.predict(dt, c.q_pos)?,
-            attitude: s.attitude.predict(dt, c.q_rot, c.q_w)?,
+            attitude: s.attitude.predict(
+                dt,
+                &AttitudeNoise {
+                    q_rot: c.q_rot,
+                    q_w: c.q_w,
+                    q_w_sensor: c.q_w_sensor,
+                },
+            )?,
         })
     }
 
@@ -376,6 +371,7 @@ fn to_prediction(s: &State) -> Prediction {
         pose: Pose::new(s.attitude.r_sensor_target, s.position.p_sensor),
         v_sensor: s.position.v_sensor,
         w_target: s.attitude.w_target,
+        w_inertial_sensor: s.attitude.w_inertial_sensor,
         covariance,
         attitude_covariance: s.attitude.covariance,
         position_covariance: s.position.covariance,

@@ -51,6 +51,7 @@ fn config() -> FilterConfig {
         q_pos: 1e-8,
         q_rot: 1e-10,
         q_w: 1e-10,
+        q_w_sensor: 1e-10,
         sigma_rot_deg: 0.5,
         sigma_pos_m: 0.01,
         // The χ² gate of the filter library, tested below.

@@ -1,13 +1,14 @@
-//! The Kalman update shared by both sub-filters.
+//! The Kalman update shared by both sub-filters, and the registration's
+//! covariance from its information matrix.
 //!
 //! Both the position filter (state `[p; v]`) and the attitude IEKF (error
-//! state `[ξ_R; ξ_ω]`) have six states of which the first three are observed
-//! directly: `H = [I₃ 0]`. This module implements that update once, with the
+//! state `[ξ_R; ξ_ω; ξ_Ω]`) observe their first three states directly:
+//! `H = [I₃ 0]`. This module implements that update once, with the
 //! Joseph form `P⁺ = (I - K H) P (I - K H)ᵀ + K N Kᵀ`, which stays symmetric
 //! positive definite for any gain, followed by an explicit symmetrisation.
 
 use crate::error::FilterError;
-use nalgebra::{Matrix3, Matrix3x6, Matrix6, Matrix6x3, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix6, SMatrix, SVector, Vector3};
 
 /// A 3-D innovation (measurement residual) and its covariance
 /// `S = H P Hᵀ + N`.
@@ -20,9 +21,13 @@ pub struct Innovation {
 }
 
 impl Innovation {
-    /// The innovation of a 6-state filter with `H = [I₃ 0]`, covariance `P`
-    /// and measurement noise `N`.
-    pub fn new(residual: Vector3<f64>, p: &Matrix6<f64>, n: &Matrix3<f64>) -> Self {
+    /// The innovation of an `N`-state filter with `H = [I₃ 0]`, covariance
+    /// `P` and measurement noise `N`.
+    pub fn new<const D: usize>(
+        residual: Vector3<f64>,
+        p: &SMatrix<f64, D, D>,
+        n: &Matrix3<f64>,
+    ) -> Self {
         let covariance = symmetrize3(&(p.fixed_view::<3, 3>(0, 0) + n));
         Self {
             residual,
@@ -44,43 +49,86 @@ impl Innovation {
 
 /// Correction `δx = K y` and posterior covariance of one update.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct KalmanStep {
+pub(crate) struct KalmanStep<const D: usize> {
     /// `δx = K y`.
-    pub correction: Vector6<f64>,
+    pub correction: SVector<f64, D>,
     /// Joseph-form posterior covariance.
-    pub covariance: Matrix6<f64>,
+    pub covariance: SMatrix<f64, D, D>,
 }
 
 /// One Kalman update with `H = [I₃ 0]`: `K = P Hᵀ S⁻¹`, `δx = K y`,
 /// `P⁺ = (I - K H) P (I - K H)ᵀ + K N Kᵀ` (Joseph form).
-pub(crate) fn update_first_block(
-    p: &Matrix6<f64>,
+pub(crate) fn update_first_block<const D: usize>(
+    p: &SMatrix<f64, D, D>,
     innovation: &Innovation,
     n: &Matrix3<f64>,
-) -> Result<KalmanStep, FilterError> {
+) -> Result<KalmanStep<D>, FilterError> {
     let chol = innovation
         .covariance
         .cholesky()
         .ok_or(FilterError::NotPositiveDefinite {
             what: "innovation covariance",
         })?;
-    let p_ht: Matrix6x3<f64> = p.fixed_columns::<3>(0).into_owned();
+    let p_ht: SMatrix<f64, D, 3> = p.fixed_columns::<3>(0).into_owned();
     // S is symmetric, so K = P Hᵀ S⁻¹ = (S⁻¹ (P Hᵀ)ᵀ)ᵀ.
-    let k: Matrix6x3<f64> = chol.solve(&p_ht.transpose()).transpose();
-    let mut h = Matrix3x6::zeros();
+    let k: SMatrix<f64, D, 3> = chol.solve(&p_ht.transpose()).transpose();
+    let mut h = SMatrix::<f64, 3, D>::zeros();
     h.fixed_view_mut::<3, 3>(0, 0)
         .copy_from(&Matrix3::identity());
-    let i_kh = Matrix6::identity() - k * h;
-    let covariance = symmetrize6(&(i_kh * p * i_kh.transpose() + k * n * k.transpose()));
+    let i_kh = SMatrix::<f64, D, D>::identity() - k * h;
+    let covariance = symmetrize(&(i_kh * p * i_kh.transpose() + k * n * k.transpose()));
     Ok(KalmanStep {
         correction: k * innovation.residual,
         covariance,
     })
 }
 
+/// The registration's covariance from its information matrix (6x6,
+/// `δ = [rot; trans]`, left-⊕ of Eq. 5): `Σ = Λ⁻¹`. Fails when `Λ` is not
+/// finite, symmetric and positive definite (e.g. a degenerate geometry).
+pub fn covariance_from_information(
+    information: &Matrix6<f64>,
+) -> Result<Matrix6<f64>, FilterError> {
+    let what = "registration information matrix";
+    if !information.iter().all(|v| v.is_finite()) {
+        return Err(FilterError::NonFinite { what });
+    }
+    if (information - information.transpose()).abs().max() > 1e-9 * information.abs().max() {
+        return Err(FilterError::NotPositiveDefinite { what });
+    }
+    let sym = (information + information.transpose()) * 0.5;
+    let chol = sym
+        .cholesky()
+        .ok_or(FilterError::NotPositiveDefinite { what })?;
+    let inv = chol.inverse();
+    let inv = (inv + inv.transpose()) * 0.5;
+    if !inv.iter().all(|v| v.is_finite()) {
+        return Err(FilterError::NotPositiveDefinite { what });
+    }
+    Ok(inv)
+}
+
 /// `(M + Mᵀ) / 2`.
-pub(crate) fn symmetrize6(m: &Matrix6<f64>) -> Matrix6<f64> {
+pub(crate) fn symmetrize<const D: usize>(m: &SMatrix<f64, D, D>) -> SMatrix<f64, D, D> {
     (m + m.transpose()) * 0.5
+}
+
+/// Checks that a covariance is finite, symmetric (to a relative 1e-9) and
+/// positive definite.
+pub(crate) fn check_covariance<const D: usize>(
+    m: &SMatrix<f64, D, D>,
+    what: &'static str,
+) -> Result<(), FilterError> {
+    if !m.iter().all(|v| v.is_finite()) {
+        return Err(FilterError::NonFinite { what });
+    }
+    if (m - m.transpose()).abs().max() > 1e-9 * m.abs().max() {
+        return Err(FilterError::NotPositiveDefinite { what });
+    }
+    symmetrize(m)
+        .cholesky()
+        .ok_or(FilterError::NotPositiveDefinite { what })?;
+    Ok(())
 }
 
 /// `(M + Mᵀ) / 2`.

@@ -2,8 +2,9 @@
 //!
 //! - [`position`]: linear Kalman filter on `[p; v]`, constant velocity
 //!   (Eq. 8, 10).
-//! - [`attitude`]: invariant EKF on `(R, ω)`, constant angular velocity
-//!   (Eq. 9, 11), derivation in its module docs.
+//! - [`attitude`]: invariant EKF on `(R, ω, Ω)`: the target's and the
+//!   sensor frame's angular velocities, both constant (Eq. 9, 11 with the
+//!   sensor frame's turn added), derivation in its module docs.
 //! - [`filter`]: [`RelativeMotionFilter`], both filters behind one clock, with
 //!   prediction at any time, measurement noise from the registration's
 //!   information matrix and a Mahalanobis innovation gate.
@@ -17,7 +18,8 @@
 //!
 //! Units SI. `R = r_sensor_target` (target body → sensor), `p = p_sensor` the
 //! target origin in the sensor frame, `v_sensor = dp/dt` in the sensor frame,
-//! `w_target` the target's angular velocity in the target frame.
+//! `w_target` the target's angular velocity relative to the sensor frame, in
+//! the target frame.
 #![forbid(unsafe_code)]
 
 pub mod attitude;
@@ -29,7 +31,7 @@ pub mod motion_compensation;
 mod outputs;
 pub mod position;
 
-pub use attitude::AttitudeFilter;
+pub use attitude::{AttitudeFilter, AttitudeNoise, Matrix9};
 pub use config::FilterConfig;
 pub use error::FilterError;
 pub use filter::{RelativeMotionFilter, covariance_from_information};

@@ -1,6 +1,7 @@
 //! What the [`RelativeMotionFilter`](crate::RelativeMotionFilter) hands
 //! out: its propagated estimate and the outcome of one update.
 
+use crate::attitude::Matrix9;
 use nalgebra::{Matrix6, Vector3};
 use spacepose_geometry::Pose;
 
@@ -13,13 +14,19 @@ pub struct Prediction {
     pub pose: Pose,
     /// Velocity of the target origin in the sensor frame (m/s).
     pub v_sensor: Vector3<f64>,
-    /// Angular velocity of the target in the target frame (rad/s).
+    /// Angular velocity of the target relative to the sensor frame, in the
+    /// target frame (rad/s): the motion within a scan.
     pub w_target: Vector3<f64>,
+    /// Angular velocity of the sensor frame w.r.t. inertial space, in the
+    /// sensor frame (rad/s): the chaser's own turn as the filter estimates
+    /// it (0 when `FilterConfig::sensor_rate` is off).
+    pub w_inertial_sensor: Vector3<f64>,
     /// Pose covariance, `δ = [rot; trans]` in the left-⊕ convention of
     /// Eq. (5) (the convention of the registration).
     pub covariance: Matrix6<f64>,
-    /// Full covariance of the attitude filter, `[ξ_R; ξ_ω]`.
-    pub attitude_covariance: Matrix6<f64>,
+    /// Full covariance of the attitude filter, `[ξ_R; ξ_u; ξ_Ω]` (`u` =
+    /// `w_target`, `Ω` = `w_inertial_sensor`; `crate::attitude`).
+    pub attitude_covariance: Matrix9,
     /// Full covariance of the position filter, `[p; v]`.
     pub position_covariance: Matrix6<f64>,
 }

@@ -14,7 +14,9 @@
 //! (see [`crate::kalman`]).
 
 use crate::error::FilterError;
-use crate::kalman::{Innovation, checked_covariance3, symmetrize6, update_first_block};
+use crate::kalman::{
+    Innovation, check_covariance, checked_covariance3, symmetrize, update_first_block,
+};
 use nalgebra::{Matrix3, Matrix6, Vector3};
 
 /// Position/velocity estimate of the target in the sensor frame.
@@ -45,11 +47,11 @@ impl PositionFilter {
                 what: "position filter state",
             });
         }
-        check_covariance6(&covariance, "position filter covariance")?;
+        check_covariance(&covariance, "position filter covariance")?;
         Ok(Self {
             p_sensor,
             v_sensor,
-            covariance: symmetrize6(&covariance),
+            covariance: symmetrize(&covariance),
         })
     }
 
@@ -81,7 +83,7 @@ impl PositionFilter {
         check_step(dt, q_pos)?;
         let f = Self::transition_matrix(dt);
         let covariance =
-            symmetrize6(&(f * self.covariance * f.transpose() + Self::process_noise(dt, q_pos)));
+            symmetrize(&(f * self.covariance * f.transpose() + Self::process_noise(dt, q_pos)));
         Ok(Self {
             p_sensor: self.p_sensor + self.v_sensor * dt,
             v_sensor: self.v_sensor,
@@ -139,20 +141,6 @@ pub(crate) fn check_step(dt: f64, q: f64) -> Result<(), FilterError> {
             "negative process noise {q}"
         )));
     }
-    Ok(())
-}
-
-/// Finite, symmetric (relative 1e-9) and positive definite.
-pub(crate) fn check_covariance6(m: &Matrix6<f64>, what: &'static str) -> Result<(), FilterError> {
-    if !m.iter().all(|v| v.is_finite()) {
-        return Err(FilterError::NonFinite { what });
-    }
-    if (m - m.transpose()).abs().max() > 1e-9 * m.abs().max() {
-        return Err(FilterError::NotPositiveDefinite { what });
-    }
-    symmetrize6(m)
-        .cholesky()
-        .ok_or(FilterError::NotPositiveDefinite { what })?;
     Ok(())
 }
 

@@ -63,8 +63,9 @@ fn prediction(pose: Pose, var_rad2: f64) -> Prediction {
         pose,
         v_sensor: Vector3::zeros(),
         w_target: Vector3::zeros(),
+        w_inertial_sensor: nalgebra::Vector3::zeros(),
         covariance,
-        attitude_covariance: Matrix6::identity(),
+        attitude_covariance: spacepose_filter::Matrix9::identity(),
         position_covariance: Matrix6::identity(),
     }
 }

@@ -91,7 +91,7 @@ mod tests {
     use spacepose_geometry::Pose;
 
     fn prediction(sigma_w_deg_s: [f64; 3]) -> Prediction {
-        let mut attitude_covariance = Matrix6::identity() * 1e-6;
+        let mut attitude_covariance = spacepose_filter::Matrix9::identity() * 1e-6;
         for (i, s) in sigma_w_deg_s.iter().enumerate() {
             attitude_covariance[(3 + i, 3 + i)] = s.to_radians().powi(2);
         }
@@ -100,6 +100,7 @@ mod tests {
             pose: Pose::identity(),
             v_sensor: Vector3::zeros(),
             w_target: Vector3::zeros(),
+            w_inertial_sensor: nalgebra::Vector3::zeros(),
             covariance: Matrix6::identity(),
             attitude_covariance,
             position_covariance: Matrix6::identity(),

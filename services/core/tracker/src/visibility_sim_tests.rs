@@ -19,8 +19,9 @@ fn prediction(t: f64, pose: Pose) -> Prediction {
         pose,
         v_sensor: Vector3::zeros(),
         w_target: Vector3::zeros(),
+        w_inertial_sensor: nalgebra::Vector3::zeros(),
         covariance: Matrix6::identity() * 1e-8,
-        attitude_covariance: Matrix6::identity() * 1e-8,
+        attitude_covariance: spacepose_filter::Matrix9::identity() * 1e-8,
         position_covariance: Matrix6::identity() * 1e-8,
     }
 }

@@ -29,8 +29,9 @@ fn prediction(w_target: Vector3<f64>) -> Prediction {
         pose: Pose::new(Rotation3::identity(), Vector3::new(0.0, 0.0, 15.0)),
         v_sensor: Vector3::zeros(),
         w_target,
+        w_inertial_sensor: nalgebra::Vector3::zeros(),
         covariance: Matrix6::identity() * 1e-6,
-        attitude_covariance: Matrix6::identity() * 1e-6,
+        attitude_covariance: spacepose_filter::Matrix9::identity() * 1e-6,
         position_covariance: Matrix6::identity() * 1e-6,
     }
 }

@@ -40,8 +40,8 @@ pub fn from_acquisition(a: &AcquisitionResult) -> Result<Option<TargetPrediction
 }
 
 /// Square root of the largest diagonal entry of the 3×3 block starting at
-/// `first` of a 6×6 covariance (the worst-axis standard deviation).
-fn worst_sigma(covariance: &nalgebra::Matrix6<f64>, first: usize) -> f64 {
+/// `first` of the attitude covariance (the worst-axis standard deviation).
+fn worst_sigma(covariance: &spacepose_filter::Matrix9, first: usize) -> f64 {
     (first..first + 3)
         .map(|i| covariance[(i, i)])
         .fold(0.0_f64, f64::max)
@@ -57,7 +57,7 @@ mod tests {
 
     #[test]
     fn a_filter_state_gives_the_attitude_and_its_worst_sigmas() {
-        let mut attitude_covariance = Matrix6::identity() * 1e-4;
+        let mut attitude_covariance = spacepose_filter::Matrix9::identity() * 1e-4;
         attitude_covariance[(1, 1)] = 4e-4;
         attitude_covariance[(5, 5)] = 9e-4;
         let p = Prediction {
@@ -68,6 +68,7 @@ mod tests {
             ),
             v_sensor: Vector3::new(0.1, 0.0, 0.0),
             w_target: Vector3::new(0.0, 0.2, 0.0),
+            w_inertial_sensor: Vector3::zeros(),
             covariance: Matrix6::identity(),
             attitude_covariance,
             position_covariance: Matrix6::identity(),
