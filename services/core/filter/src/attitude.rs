@@ -180,7 +180,7 @@ impl AttitudeFilter {
     }
 
     /// `T` at this state, or its inverse (module docs).
-    fn to_published(&self, r: &Rotation3<f64>, inverse: bool) -> Matrix9 {
+    fn error_map(&self, r: &Rotation3<f64>, inverse: bool) -> Matrix9 {
         let sign = if inverse { 1.0 } else { -1.0 };
         published_map(r, &self.w_inertial_sensor, sign, self.sensor_rate)
     }
@@ -212,15 +212,15 @@ impl AttitudeFilter {
     /// `T(R̂⁻) F T(R̂)⁻¹` (module docs).
     pub fn transition_matrix(&self, dt: f64) -> Matrix9 {
         let r_pred = self.predicted_rotation(dt);
-        self.to_published(&r_pred, false)
+        self.error_map(&r_pred, false)
             * self.inertial_transition(dt)
-            * self.to_published(&self.r_sensor_target, true)
+            * self.error_map(&self.r_sensor_target, true)
     }
 
     /// The process noise of the kept error accumulated over `Δt`,
     /// `T(R̂⁻) Q T(R̂⁻)ᵀ` (module docs).
     pub fn process_noise(&self, dt: f64, noise: &AttitudeNoise) -> Matrix9 {
-        let t = self.to_published(&self.predicted_rotation(dt), false);
+        let t = self.error_map(&self.predicted_rotation(dt), false);
         symmetrize(&(t * self.inertial_noise(dt, noise) * t.transpose()))
     }
 

@@ -150,18 +150,18 @@ fn f_matches_numerical_linearisation() {
 fn t_maps_the_inertial_error_to_the_kept_one() {
     let est = some_filter(true);
     let t_num = numerical_jacobian(|xi| error_of(&perturbed_inertial(&est, xi), &est, true));
-    let t = est.to_published(&est.r_sensor_target, false);
+    let t = est.error_map(&est.r_sensor_target, false);
     assert!(
         (t - t_num).abs().max() < 1e-7,
         "T = {t}\nnumerical = {t_num}"
     );
-    let t_inv = est.to_published(&est.r_sensor_target, true);
+    let t_inv = est.error_map(&est.r_sensor_target, true);
     assert!((t * t_inv - Matrix9::identity()).abs().max() < 1e-12);
     // Off: u = ω and T = I.
     let off = some_filter(false);
     assert_eq!(off.w_target, off.w_inertial_target());
     assert_eq!(
-        off.to_published(&off.r_sensor_target, false),
+        off.error_map(&off.r_sensor_target, false),
         Matrix9::identity()
     );
 }
