@@ -327,37 +327,15 @@ fn rejects_bad_input() {
     let bad = Rotation3::from_matrix_unchecked(Matrix3::from_element(f64::NAN));
     assert!(f.innovation(&bad, &Matrix3::identity()).is_err());
     assert!(f.innovation(&some_attitude(), &Matrix3::zeros()).is_err());
-    let w_inf = Vector3::new(f64::INFINITY, 0.0, 0.0);
-    assert!(
-        AttitudeFilter::new(
-            some_attitude(),
-            w_inf,
-            Vector3::zeros(),
-            Matrix9::identity(),
-            true
-        )
-        .is_err()
-    );
-    assert!(
-        AttitudeFilter::new(
-            some_attitude(),
-            Vector3::zeros(),
-            w_inf,
-            Matrix9::identity(),
-            true
-        )
-        .is_err()
-    );
-    assert!(
-        AttitudeFilter::new(
-            some_attitude(),
-            Vector3::zeros(),
-            Vector3::zeros(),
-            -Matrix9::identity(),
-            true
-        )
-        .is_err()
-    );
+    let (zero, w_inf) = (Vector3::zeros(), Vector3::new(f64::INFINITY, 0.0, 0.0));
+    let bad_states = [
+        (w_inf, zero, Matrix9::identity()),
+        (zero, w_inf, Matrix9::identity()),
+        (zero, zero, -Matrix9::identity()),
+    ];
+    for (w, big_w, p) in bad_states {
+        assert!(AttitudeFilter::new(some_attitude(), w, big_w, p, true).is_err());
+    }
 }
 
 #[test]
