@@ -22,7 +22,10 @@ pub struct FilterConfig {
     pub q_w: f64,
     /// Estimate the sensor frame's own angular velocity `Ω` beside the
     /// target's (`crate::attitude`; `docs/design/sensor-frame-rate.md`).
-    /// Off: seed 000's constant relative rate (Eq. 9).
+    /// Off (the default): seed 000's constant relative rate (Eq. 9). Off by
+    /// default until the clutter demo's start-up with it is understood: its
+    /// end-to-end test failed in 3 of 4 full-suite runs with it on (the
+    /// design note).
     pub sensor_rate: bool,
     /// Random-walk density of the sensor frame's angular velocity
     /// (rad²/s³). 1e-6: the fly-around turns the chaser by up to about
@@ -74,7 +77,7 @@ impl Default for FilterConfig {
             q_pos: 1e-4,
             q_rot: 1e-6,
             q_w: 3e-5,
-            sensor_rate: true,
+            sensor_rate: false,
             q_w_sensor: 1e-6,
             initial_sigma_w_sensor_degps: 2.0,
             sigma_rot_deg: 1.0,
