@@ -7,10 +7,7 @@
 //! [`RelativeMotionFilter::restore`] it and predict to any time itself
 //! (seed 000 Eq. 8-9).
 
-use super::{
-    matrix_from_wire, matrix_to_wire, matrix6_from_wire, matrix6_to_wire, vector3_from_wire,
-    vector3_to_wire,
-};
+use super::{matrix_from_wire, matrix_to_wire, vector3_from_wire, vector3_to_wire};
 use crate::error::MessageError;
 use crate::{AcquisitionResult, FilterState, PoseEstimate, WireStatus};
 use nalgebra::{Matrix6, Vector3};
@@ -54,7 +51,7 @@ pub fn state_from_prediction(p: &Prediction, sequence: u64) -> FilterState {
     s.w_target = vector3_to_wire(&p.w_target);
     s.w_inertial_sensor = vector3_to_wire(&p.w_inertial_sensor);
     s.attitude_covariance = matrix_to_wire(&p.attitude_covariance);
-    s.position_covariance = matrix6_to_wire(&p.position_covariance);
+    s.position_covariance = matrix_to_wire(&p.position_covariance);
     s
 }
 
@@ -89,7 +86,7 @@ pub fn prediction_from_state(s: &FilterState) -> Result<Option<Prediction>, Mess
         return Err(invalid(WHAT, "non-finite velocity or covariance"));
     }
     let attitude_covariance = matrix_from_wire(&s.attitude_covariance);
-    let position_covariance = matrix6_from_wire(&s.position_covariance);
+    let position_covariance = matrix_from_wire(&s.position_covariance);
     let mut covariance = Matrix6::zeros();
     covariance
         .fixed_view_mut::<3, 3>(0, 0)
@@ -125,7 +122,7 @@ pub fn measurement_from_estimate(e: &PoseEstimate) -> Result<Measurement, Messag
     let covariance = flat
         .iter()
         .any(|&v| v != 0.0)
-        .then(|| matrix6_from_wire(&e.covariance));
+        .then(|| matrix_from_wire(&e.covariance));
     Ok(Measurement {
         t: e.t_s,
         t_sensor_target,

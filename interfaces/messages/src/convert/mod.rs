@@ -18,7 +18,7 @@ pub use filter::{
 };
 
 use crate::error::MessageError;
-use nalgebra::{Matrix6, Quaternion, Rotation3, SMatrix, UnitQuaternion, Vector3};
+use nalgebra::{Quaternion, Rotation3, SMatrix, UnitQuaternion, Vector3};
 use spacepose_geometry::Pose;
 
 /// Largest accepted deviation of a received quaternion's norm from 1.
@@ -70,16 +70,6 @@ pub fn vector3_to_wire(v: &Vector3<f64>) -> [f64; 3] {
 /// An array as a 3-vector.
 pub fn vector3_from_wire(v: &[f64; 3]) -> Vector3<f64> {
     Vector3::new(v[0], v[1], v[2])
-}
-
-/// A 6x6 matrix as row-major arrays.
-pub fn matrix6_to_wire(m: &Matrix6<f64>) -> [[f64; 6]; 6] {
-    matrix_to_wire(m)
-}
-
-/// Row-major arrays as a 6x6 matrix.
-pub fn matrix6_from_wire(m: &[[f64; 6]; 6]) -> Matrix6<f64> {
-    matrix_from_wire(m)
 }
 
 /// A square matrix as row-major arrays.
@@ -149,9 +139,9 @@ mod tests {
         msg.set_pose(&pose);
         let (angle, dist) = msg.pose().unwrap().error_to(&pose);
         assert!(angle < 1e-12 && dist < 1e-12);
-        let m = Matrix6::from_fn(|r, c| (r * 6 + c) as f64);
-        let wire = matrix6_to_wire(&m);
+        let m = nalgebra::Matrix6::from_fn(|r, c| (r * 6 + c) as f64);
+        let wire = matrix_to_wire(&m);
         assert_eq!(wire[1][2], 8.0);
-        assert_eq!(matrix6_from_wire(&wire), m);
+        assert_eq!(matrix_from_wire(&wire), m);
     }
 }

@@ -68,9 +68,7 @@
 //! With `sensor_rate` off, `Ω` stays 0 and uncoupled: Eq. (9) exactly.
 
 use crate::error::FilterError;
-use crate::kalman::{
-    Innovation, check_covariance, checked_covariance3, symmetrize, update_first_block,
-};
+use crate::kalman::{Innovation, checked_covariance, symmetrize, update_first_block};
 use crate::position::check_step;
 use nalgebra::{Matrix3, Rotation3, SMatrix, UnitQuaternion, Vector3};
 use spacepose_geometry::so3;
@@ -133,12 +131,12 @@ impl AttitudeFilter {
                 what: "attitude filter state",
             });
         }
-        check_covariance(&covariance, "attitude filter covariance")?;
+        let covariance = checked_covariance(&covariance, "attitude filter covariance")?;
         let mut f = Self {
             r_sensor_target: renormalize(&r_sensor_target),
             w_target,
             w_inertial_sensor,
-            covariance: symmetrize(&covariance),
+            covariance,
             sensor_rate,
         };
         if !sensor_rate {
@@ -151,12 +149,8 @@ impl AttitudeFilter {
     /// nothing ever couples to it).
     fn decouple_sensor_rate(&mut self) {
         self.w_inertial_sensor = Vector3::zeros();
-        let omega = self.covariance.fixed_view::<3, 3>(6, 6).into_owned();
-        self.covariance.fixed_view_mut::<9, 3>(0, 6).fill(0.0);
-        self.covariance.fixed_view_mut::<3, 9>(6, 0).fill(0.0);
-        self.covariance
-            .fixed_view_mut::<3, 3>(6, 6)
-            .copy_from(&omega);
+        self.covariance.fixed_view_mut::<6, 3>(0, 6).fill(0.0);
+        self.covariance.fixed_view_mut::<3, 6>(6, 0).fill(0.0);
     }
 
     /// The angular velocity of the target w.r.t. inertial space, in the
@@ -172,81 +166,76 @@ impl AttitudeFilter {
 
     /// The propagated mean `Exp(-Ω̂Δt) R̂ Exp(ω̂ Δt)`.
     pub fn predicted_rotation(&self, dt: f64) -> Rotation3<f64> {
-        renormalize(
-            &(so3::exp(&(-self.w_inertial_sensor * dt))
-                * self.r_sensor_target
-                * so3::exp(&(self.w_inertial_target() * dt))),
-        )
+        self.step(dt).r_pred
     }
 
-    /// `T` at this state, or its inverse (module docs).
+    /// `T` of the module docs at attitude `r` and this `Ω̂`, or its
+    /// inverse: `[[I, 0, 0], [∓R̂ᵀ[Ω̂]ₓ, I, ∓R̂ᵀ], [0, 0, I]]`; the identity
+    /// when `Ω` is not estimated (it is then known to be 0, and `u = ω`).
     fn error_map(&self, r: &Rotation3<f64>, inverse: bool) -> Matrix9 {
+        let mut t = Matrix9::identity();
+        if !self.sensor_rate {
+            return t;
+        }
         let sign = if inverse { 1.0 } else { -1.0 };
-        published_map(r, &self.w_inertial_sensor, sign, self.sensor_rate)
+        let rt = r.inverse().into_inner() * sign;
+        t.fixed_view_mut::<3, 3>(3, 0)
+            .copy_from(&(rt * self.w_inertial_sensor.cross_matrix()));
+        t.fixed_view_mut::<3, 3>(3, 6).copy_from(&rt);
+        t
     }
 
-    /// The couplings `(B_ω, B_Ω)` of the rates into the attitude error.
-    fn couplings(&self, dt: f64) -> (Matrix3<f64>, Matrix3<f64>) {
-        let b_w =
-            self.predicted_rotation(dt).matrix() * right_jacobian(&(self.w_inertial_target() * dt));
+    /// What one propagation over `Δt` needs, computed once.
+    fn step(&self, dt: f64) -> Step {
+        let turn_sensor = so3::exp(&(-self.w_inertial_sensor * dt));
+        let w = self.w_inertial_target();
+        let r_pred = renormalize(&(turn_sensor * self.r_sensor_target * so3::exp(&(w * dt))));
         let b_sensor = if self.sensor_rate {
             -right_jacobian(&(self.w_inertial_sensor * dt))
         } else {
             Matrix3::zeros()
         };
-        (b_w, b_sensor)
+        Step {
+            dt,
+            turn_sensor,
+            b_w: r_pred.matrix() * right_jacobian(&(w * dt)),
+            b_sensor,
+            t_pred: self.error_map(&r_pred, false),
+            r_pred,
+        }
     }
 
-    /// The transition `F` of the error `[ξ_R; ξ_ω; ξ_Ω]` (module docs).
+    /// The transition `F` of the error `[ξ_R; ξ_ω; ξ_Ω]` (module docs;
+    /// checked against finite differences by the tests).
+    #[cfg(test)]
     fn inertial_transition(&self, dt: f64) -> Matrix9 {
-        let (b_w, b_sensor) = self.couplings(dt);
-        let mut f = Matrix9::identity();
-        f.fixed_view_mut::<3, 3>(0, 0)
-            .copy_from(so3::exp(&(-self.w_inertial_sensor * dt)).matrix());
-        f.fixed_view_mut::<3, 3>(0, 3).copy_from(&(b_w * dt));
-        f.fixed_view_mut::<3, 3>(0, 6).copy_from(&(b_sensor * dt));
-        f
+        self.step(dt).inertial_transition()
     }
 
     /// The transition of the kept error `[ξ_R; ξ_u; ξ_Ω]`,
     /// `T(R̂⁻) F T(R̂)⁻¹` (module docs).
     pub fn transition_matrix(&self, dt: f64) -> Matrix9 {
-        let r_pred = self.predicted_rotation(dt);
-        self.error_map(&r_pred, false)
-            * self.inertial_transition(dt)
-            * self.error_map(&self.r_sensor_target, true)
+        self.transition_of(&self.step(dt))
+    }
+
+    fn transition_of(&self, step: &Step) -> Matrix9 {
+        step.t_pred * step.inertial_transition() * self.error_map(&self.r_sensor_target, true)
     }
 
     /// The process noise of the kept error accumulated over `Δt`,
     /// `T(R̂⁻) Q T(R̂⁻)ᵀ` (module docs).
     pub fn process_noise(&self, dt: f64, noise: &AttitudeNoise) -> Matrix9 {
-        let t = self.error_map(&self.predicted_rotation(dt), false);
-        symmetrize(&(t * self.inertial_noise(dt, noise) * t.transpose()))
+        self.process_noise_of(&self.step(dt), noise)
     }
 
-    /// The process noise `Q` of `[ξ_R; ξ_ω; ξ_Ω]` over `Δt` (module docs).
-    fn inertial_noise(&self, dt: f64, noise: &AttitudeNoise) -> Matrix9 {
-        let (b_w, b_sensor) = self.couplings(dt);
+    fn process_noise_of(&self, step: &Step, noise: &AttitudeNoise) -> Matrix9 {
         let q_sensor = if self.sensor_rate {
             noise.q_w_sensor
         } else {
             0.0
         };
-        let mut q = Matrix9::zeros();
-        q.fixed_view_mut::<3, 3>(0, 0)
-            .copy_from(&(Matrix3::identity() * (noise.q_rot * dt)));
-        for (offset, b, density) in [(3, b_w, noise.q_w), (6, b_sensor, q_sensor)] {
-            let mut rr = q.fixed_view::<3, 3>(0, 0).into_owned();
-            rr += b * b.transpose() * (density * dt.powi(3) / 3.0);
-            q.fixed_view_mut::<3, 3>(0, 0).copy_from(&rr);
-            let cross = b * (density * dt * dt / 2.0);
-            q.fixed_view_mut::<3, 3>(0, offset).copy_from(&cross);
-            q.fixed_view_mut::<3, 3>(offset, 0)
-                .copy_from(&cross.transpose());
-            q.fixed_view_mut::<3, 3>(offset, offset)
-                .copy_from(&(Matrix3::identity() * (density * dt)));
-        }
-        symmetrize(&q)
+        let t = &step.t_pred;
+        symmetrize(&(t * step.inertial_noise(noise, q_sensor) * t.transpose()))
     }
 
     /// The prediction `Δt ≥ 0` seconds ahead; `self` is unchanged.
@@ -254,19 +243,18 @@ impl AttitudeFilter {
         check_step(dt, noise.q_rot)?;
         check_step(dt, noise.q_w)?;
         check_step(dt, noise.q_w_sensor)?;
-        let f = self.transition_matrix(dt);
-        let p = f * self.covariance * f.transpose() + self.process_noise(dt, noise);
-        let r_pred = self.predicted_rotation(dt);
+        let step = self.step(dt);
+        let f = self.transition_of(&step);
+        let p = f * self.covariance * f.transpose() + self.process_noise_of(&step, noise);
         // ω and Ω are constant: u⁻ = ω - R̂⁻ᵀ Ω.
-        let w_target = self.w_inertial_target() - r_pred.inverse() * self.w_inertial_sensor;
+        let w_target = self.w_inertial_target() - step.r_pred.inverse() * self.w_inertial_sensor;
         Ok(Self {
-            r_sensor_target: r_pred,
+            r_sensor_target: step.r_pred,
             w_target,
             covariance: symmetrize(&p),
             ..*self
         })
     }
-
     /// The innovation `y = Log(R̄ R̂ᵀ)` of a measured attitude with noise `N`
     /// (left perturbation, rad²).
     pub fn innovation(
@@ -279,7 +267,7 @@ impl AttitudeFilter {
                 what: "measured attitude",
             });
         }
-        let n = checked_covariance3(n, "attitude measurement covariance")?;
+        let n = checked_covariance(n, "attitude measurement covariance")?;
         let y = so3::log(&(r_measured * self.r_sensor_target.inverse()));
         Ok(Innovation::new(y, &self.covariance, &n))
     }
@@ -310,24 +298,52 @@ impl AttitudeFilter {
     }
 }
 
-/// `T` (`sign = -1`) or `T⁻¹` (`sign = +1`) of the module docs:
-/// `[[I, 0, 0], [±R̂ᵀ[Ω̂]ₓ, I, ±R̂ᵀ], [0, 0, I]]`; the identity when `Ω` is
-/// not estimated (it is then known to be 0, and `u = ω`).
-fn published_map(
-    r: &Rotation3<f64>,
-    w_inertial_sensor: &Vector3<f64>,
-    sign: f64,
-    sensor_rate: bool,
-) -> Matrix9 {
-    let rt = r.inverse().into_inner();
-    let mut t = Matrix9::identity();
-    if !sensor_rate {
-        return t;
+/// One propagation step's mean and couplings (module docs).
+struct Step {
+    dt: f64,
+    /// `Exp(-Ω̂Δt)`, the attitude block of `F`.
+    turn_sensor: Rotation3<f64>,
+    /// `R̂⁻ = Exp(-Ω̂Δt) R̂ Exp(ω̂Δt)`.
+    r_pred: Rotation3<f64>,
+    /// `B_ω = R̂⁻ J_r(ω̂Δt)`.
+    b_w: Matrix3<f64>,
+    /// `B_Ω = -J_r(Ω̂Δt)` (0 when `Ω` is not estimated).
+    b_sensor: Matrix3<f64>,
+    /// `T(R̂⁻)`.
+    t_pred: Matrix9,
+}
+
+impl Step {
+    /// `F` of `[ξ_R; ξ_ω; ξ_Ω]`.
+    fn inertial_transition(&self) -> Matrix9 {
+        let mut f = Matrix9::identity();
+        f.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(self.turn_sensor.matrix());
+        f.fixed_view_mut::<3, 3>(0, 3)
+            .copy_from(&(self.b_w * self.dt));
+        f.fixed_view_mut::<3, 3>(0, 6)
+            .copy_from(&(self.b_sensor * self.dt));
+        f
     }
-    t.fixed_view_mut::<3, 3>(3, 0)
-        .copy_from(&(rt * w_inertial_sensor.cross_matrix() * sign));
-    t.fixed_view_mut::<3, 3>(3, 6).copy_from(&(rt * sign));
-    t
+
+    /// `Q` of `[ξ_R; ξ_ω; ξ_Ω]`: white attitude noise and the two random
+    /// walks (`q_sensor` 0 when `Ω` is not estimated).
+    fn inertial_noise(&self, noise: &AttitudeNoise, q_sensor: f64) -> Matrix9 {
+        let dt = self.dt;
+        let mut q = Matrix9::zeros();
+        let mut rr = Matrix3::identity() * (noise.q_rot * dt);
+        for (offset, b, density) in [(3, self.b_w, noise.q_w), (6, self.b_sensor, q_sensor)] {
+            rr += b * b.transpose() * (density * dt.powi(3) / 3.0);
+            let cross = b * (density * dt * dt / 2.0);
+            q.fixed_view_mut::<3, 3>(0, offset).copy_from(&cross);
+            q.fixed_view_mut::<3, 3>(offset, 0)
+                .copy_from(&cross.transpose());
+            q.fixed_view_mut::<3, 3>(offset, offset)
+                .copy_from(&(Matrix3::identity() * (density * dt)));
+        }
+        q.fixed_view_mut::<3, 3>(0, 0).copy_from(&rr);
+        symmetrize(&q)
+    }
 }
 
 /// Projects a nearly orthonormal matrix back onto SO(3) (through the unit

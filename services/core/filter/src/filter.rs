@@ -13,7 +13,7 @@
 use crate::attitude::{AttitudeFilter, AttitudeNoise, Matrix9};
 use crate::config::FilterConfig;
 use crate::error::FilterError;
-use crate::kalman::checked_covariance3;
+use crate::kalman::checked_covariance;
 pub use crate::kalman::covariance_from_information;
 use crate::position::PositionFilter;
 use nalgebra::{Matrix3, Matrix6, Vector3};
@@ -328,11 +328,11 @@ impl RelativeMotionFilter {
         match covariance {
             Some(cov) if c.use_registration_covariance => {
                 let scaled = cov * c.registration_covariance_scale;
-                let n_rot = checked_covariance3(
+                let n_rot = checked_covariance(
                     &scaled.fixed_view::<3, 3>(0, 0).into_owned(),
                     "measurement covariance (rotation block)",
                 )?;
-                let n_pos = checked_covariance3(
+                let n_pos = checked_covariance(
                     &scaled.fixed_view::<3, 3>(3, 3).into_owned(),
                     "measurement covariance (translation block)",
                 )?;

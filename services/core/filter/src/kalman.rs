@@ -28,7 +28,7 @@ impl Innovation {
         p: &SMatrix<f64, D, D>,
         n: &Matrix3<f64>,
     ) -> Self {
-        let covariance = symmetrize3(&(p.fixed_view::<3, 3>(0, 0) + n));
+        let covariance = symmetrize(&(p.fixed_view::<3, 3>(0, 0) + n));
         Self {
             residual,
             covariance,
@@ -114,42 +114,18 @@ pub(crate) fn symmetrize<const D: usize>(m: &SMatrix<f64, D, D>) -> SMatrix<f64,
 }
 
 /// Checks that a covariance is finite, symmetric (to a relative 1e-9) and
-/// positive definite.
-pub(crate) fn check_covariance<const D: usize>(
+/// positive definite; returns its symmetrised copy.
+pub(crate) fn checked_covariance<const D: usize>(
     m: &SMatrix<f64, D, D>,
     what: &'static str,
-) -> Result<(), FilterError> {
+) -> Result<SMatrix<f64, D, D>, FilterError> {
     if !m.iter().all(|v| v.is_finite()) {
         return Err(FilterError::NonFinite { what });
     }
     if (m - m.transpose()).abs().max() > 1e-9 * m.abs().max() {
         return Err(FilterError::NotPositiveDefinite { what });
     }
-    symmetrize(m)
-        .cholesky()
-        .ok_or(FilterError::NotPositiveDefinite { what })?;
-    Ok(())
-}
-
-/// `(M + Mᵀ) / 2`.
-pub(crate) fn symmetrize3(m: &Matrix3<f64>) -> Matrix3<f64> {
-    (m + m.transpose()) * 0.5
-}
-
-/// Checks that a 3x3 covariance is finite, symmetric (to a relative 1e-9)
-/// and positive definite; returns its symmetrised copy.
-pub(crate) fn checked_covariance3(
-    m: &Matrix3<f64>,
-    what: &'static str,
-) -> Result<Matrix3<f64>, FilterError> {
-    if !m.iter().all(|v| v.is_finite()) {
-        return Err(FilterError::NonFinite { what });
-    }
-    let asym = (m - m.transpose()).abs().max();
-    if asym > 1e-9 * m.abs().max() {
-        return Err(FilterError::NotPositiveDefinite { what });
-    }
-    let s = symmetrize3(m);
+    let s = symmetrize(m);
     s.cholesky()
         .ok_or(FilterError::NotPositiveDefinite { what })?;
     Ok(s)
@@ -183,14 +159,14 @@ mod tests {
     fn rejects_bad_covariances() {
         let nan = Matrix3::from_element(f64::NAN);
         assert!(matches!(
-            checked_covariance3(&nan, "x"),
+            checked_covariance(&nan, "x"),
             Err(FilterError::NonFinite { .. })
         ));
         let neg = -Matrix3::<f64>::identity();
-        assert!(checked_covariance3(&neg, "x").is_err());
+        assert!(checked_covariance(&neg, "x").is_err());
         let mut asym = Matrix3::<f64>::identity();
         asym[(0, 1)] = 0.5;
-        assert!(checked_covariance3(&asym, "x").is_err());
-        assert!(checked_covariance3(&Matrix3::identity(), "x").is_ok());
+        assert!(checked_covariance(&asym, "x").is_err());
+        assert!(checked_covariance(&Matrix3::identity(), "x").is_ok());
     }
 }

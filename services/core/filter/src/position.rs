@@ -14,9 +14,7 @@
 //! (see [`crate::kalman`]).
 
 use crate::error::FilterError;
-use crate::kalman::{
-    Innovation, check_covariance, checked_covariance3, symmetrize, update_first_block,
-};
+use crate::kalman::{Innovation, checked_covariance, symmetrize, update_first_block};
 use nalgebra::{Matrix3, Matrix6, Vector3};
 
 /// Position/velocity estimate of the target in the sensor frame.
@@ -47,11 +45,11 @@ impl PositionFilter {
                 what: "position filter state",
             });
         }
-        check_covariance(&covariance, "position filter covariance")?;
+        let covariance = checked_covariance(&covariance, "position filter covariance")?;
         Ok(Self {
             p_sensor,
             v_sensor,
-            covariance: symmetrize(&covariance),
+            covariance,
         })
     }
 
@@ -102,7 +100,7 @@ impl PositionFilter {
                 what: "measured position",
             });
         }
-        let n = checked_covariance3(n, "position measurement covariance")?;
+        let n = checked_covariance(n, "position measurement covariance")?;
         Ok(Innovation::new(
             p_measured - self.p_sensor,
             &self.covariance,

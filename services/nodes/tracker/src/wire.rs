@@ -2,7 +2,7 @@
 //! `PoseEstimate`. (The messages it reads are converted by
 //! `spacepose_messages::convert`; the mode travels as [`TrackingMode::code`].)
 
-use spacepose_messages::convert::matrix6_to_wire;
+use spacepose_messages::convert::matrix_to_wire;
 use spacepose_messages::{CloudHeader, Name, PoseEstimate, WireStatus};
 use spacepose_tracker::{TrackOutput, TrackStatus, TrackingMode};
 
@@ -55,7 +55,7 @@ pub fn fill_estimate(e: &mut PoseEstimate, out: &TrackOutput) {
     e.covariance = out
         .covariance
         .as_ref()
-        .map_or([[0.0; 6]; 6], matrix6_to_wire);
+        .map_or([[0.0; 6]; 6], matrix_to_wire);
     e.iterations = saturating_u32(out.iterations());
     e.held_axes = u8::try_from(out.held_axes().min(3)).unwrap_or(3);
     e.held_translations = u8::try_from(out.held_translations().min(3)).unwrap_or(3);
