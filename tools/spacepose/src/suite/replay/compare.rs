@@ -29,6 +29,9 @@ pub struct Comparison {
     pub max_position_mm: f64,
     /// Recorded frame of the first pose that differs (status or value).
     pub first_difference: Option<u64>,
+    /// Frames whose status differs: (recorded frame, recorded status,
+    /// replayed status).
+    pub status_differences: Vec<(u64, String, String)>,
     /// Recorded poses without a replayed one.
     pub missing_in_replay: usize,
     /// Replayed poses without a recorded one.
@@ -37,6 +40,11 @@ pub struct Comparison {
     pub recorded_acquisitions: Vec<AcquisitionKey>,
     /// The replay's acquisitions (frames in the recording's numbering).
     pub replayed_acquisitions: Vec<AcquisitionKey>,
+    /// Where the recording's tracks left `unconfirmed`: (instance, frame of
+    /// the first pose after an `unconfirmed` one with another status).
+    pub recorded_confirmations: Vec<(String, u64)>,
+    /// The same for the replay.
+    pub replayed_confirmations: Vec<(String, u64)>,
     /// Why the replay differs, when it does.
     pub reasons: Vec<String>,
 }
@@ -57,6 +65,23 @@ fn by_key(poses: &[TelemetryPose]) -> BTreeMap<Key, &TelemetryPose> {
         .iter()
         .map(|p| ((p.instance.clone(), p.sequence), p))
         .collect()
+}
+
+/// The frames on which each instance's track left `unconfirmed` (the
+/// confirmation landed, or the track was lost or restarted).
+fn confirmations(poses: &BTreeMap<Key, &TelemetryPose>) -> Vec<(String, u64)> {
+    let mut out = Vec::new();
+    let mut previous: Option<&Key> = None;
+    for (key, p) in poses {
+        let was_unconfirmed = previous
+            .filter(|k| k.0 == key.0)
+            .is_some_and(|k| poses[k].status == "unconfirmed");
+        if was_unconfirmed && p.status != "unconfirmed" {
+            out.push(key.clone());
+        }
+        previous = Some(key);
+    }
+    out
 }
 
 fn acquisition_keys(list: &[AcquisitionRecord]) -> Vec<AcquisitionKey> {
@@ -111,6 +136,8 @@ pub fn compare(
         replayed_poses: rep.len(),
         recorded_acquisitions: acquisition_keys(&recorded.acquisitions),
         replayed_acquisitions: acquisition_keys(&acquisitions),
+        recorded_confirmations: confirmations(&rec),
+        replayed_confirmations: confirmations(&rep),
         ..Comparison::default()
     };
     for (key, r) in &rec {
@@ -123,6 +150,10 @@ pub fn compare(
         let same_pose =
             r.q_sensor_target == p.q_sensor_target && r.p_sensor_target_m == p.p_sensor_target_m;
         c.same_status += usize::from(same_status);
+        if !same_status {
+            c.status_differences
+                .push((key.1, r.status.clone(), p.status.clone()));
+        }
         c.identical += usize::from(same_status && same_pose);
         if !(same_status && same_pose) {
             let first = c.first_difference.get_or_insert(key.1);
@@ -153,6 +184,15 @@ fn reasons(recorded: &RecordedRun, c: &Comparison) -> Vec<String> {
              init runs beside the tracker, and the frame its result lands on depends on \
              the machine's load, which a replay does not reproduce",
             c.recorded_acquisitions, c.replayed_acquisitions
+        ));
+    }
+    if c.recorded_confirmations != c.replayed_confirmations {
+        out.push(format!(
+            "the tracks left `unconfirmed` on other frames: recorded {:?}, replayed {:?} \
+             (instance, frame). init verifies an acquisition beside the tracker, and the \
+             frame its confirmation lands on depends on the machine's load; until then \
+             the tracker publishes the same pose as `unconfirmed`",
+            c.recorded_confirmations, c.replayed_confirmations
         ));
     }
     if c.missing_in_replay > 0 || c.extra_in_replay > 0 {

@@ -62,6 +62,10 @@ fn differences_are_measured_and_explained() {
     assert!(!c.reproduced());
     assert_eq!((c.matched, c.same_status, c.identical), (3, 2, 1));
     assert_eq!((c.first_difference, c.extra_in_replay), (Some(1), 1));
+    assert_eq!(
+        c.status_differences,
+        vec![(1, "tracking".to_string(), "lost".to_string())]
+    );
     assert!((c.max_position_mm - 40_000.0).abs() < 1e-6);
     assert_eq!(c.max_angle_deg, 0.0);
     assert!(c.reasons.iter().any(|r| r.contains("acquisitions")));
@@ -97,4 +101,26 @@ fn a_small_rotation_is_measured_exactly() {
         "{}",
         c.max_angle_deg
     );
+}
+
+#[test]
+fn a_confirmation_on_another_frame_is_named() {
+    let statuses = |list: &[&str]| -> Vec<TelemetryPose> {
+        (0u64..)
+            .zip(list)
+            .map(|(k, s)| pose("t", k, s, 40.0))
+            .collect()
+    };
+    let rec = recorded(
+        0..4,
+        statuses(&["unconfirmed", "unconfirmed", "tracking", "tracking"]),
+    );
+    let replay = statuses(&["unconfirmed", "unconfirmed", "unconfirmed", "tracking"]);
+    let c = compare(&rec, replay, vec![acquisition(2)]);
+    assert_eq!(c.recorded_confirmations, vec![("t".to_string(), 2)]);
+    assert_eq!(c.replayed_confirmations, vec![("t".to_string(), 3)]);
+    assert_eq!(c.status_differences.len(), 1);
+    assert_eq!(c.max_angle_deg, 0.0);
+    assert_eq!(c.reasons.len(), 1, "{:?}", c.reasons);
+    assert!(c.reasons[0].contains("unconfirmed"), "{:?}", c.reasons);
 }
