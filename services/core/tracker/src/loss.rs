@@ -54,6 +54,15 @@ pub struct LossConfig {
     /// frame to count as `tracking` ([`crate::held_axes`]): 1°, the 3°
     /// tracking goal as 3σ (an angle, the same for every target).
     pub max_held_sigma_deg: f64,
+    /// Largest turn (deg) of the target, at the predicted rate, between a
+    /// frame's mean return time and its end, for a frame of a rigid mode
+    /// (`ndt`, `icp`: one pose fitted to the whole scan, seed 000 Fig. 2)
+    /// to count as `tracking`. Such a fit is the pose of about the mean
+    /// return time, published as the scan end's, so it lags by that turn
+    /// ([`crate::assess::rigid_lag_doubt`]). 1°, as
+    /// [`Self::max_held_sigma_deg`]: an angle, the same for every target.
+    /// `deblur` and `ct-ndt` compensate the motion and are not checked.
+    pub max_rigid_lag_deg: f64,
     /// Degraded frames in a row after which the track is declared lost.
     pub max_consecutive_degraded: u32,
     /// The attitude innovation limit that follows the track once its rate
@@ -75,6 +84,7 @@ impl Default for LossConfig {
             max_final_increment_deg: 1.0,
             max_final_increment_m: 0.05,
             max_held_sigma_deg: 1.0,
+            max_rigid_lag_deg: 1.0,
             max_consecutive_degraded: 5,
             innovation: InnovationLimitConfig::default(),
         }
@@ -121,6 +131,7 @@ impl LossConfig {
             ("loss.max_final_increment_deg", l.max_final_increment_deg),
             ("loss.max_final_increment_m", l.max_final_increment_m),
             ("loss.max_held_sigma_deg", l.max_held_sigma_deg),
+            ("loss.max_rigid_lag_deg", l.max_rigid_lag_deg),
         ];
         for (name, v) in positive {
             if !(v.is_finite() && v > 0.0) {

@@ -37,6 +37,19 @@ pub(super) struct Measured {
     pub(super) refit: bool,
     /// Registration, the fallback included.
     pub(super) registration_ms: f64,
+    /// The lag of a rigid fit ([`rigid_lag_deg`]); `None` in `deblur` and
+    /// `ct-ndt` and for a compensated cloud.
+    pub(super) rigid_lag_deg: Option<f64>,
+}
+
+/// The target's turn (deg) at the predicted rate between the points' mean
+/// acquisition time and the scan's end: how far a fit of one pose to the
+/// whole scan (`ndt`, `icp`: seed 000 Fig. 2), the pose of about the mean
+/// return time, lags the scan end it is published for
+/// ([`crate::assess::rigid_lag_doubt`]).
+fn rigid_lag_deg(cloud: &[Point], prediction: &Prediction, scan: &ScanTimes) -> f64 {
+    let mean_t = cloud.iter().map(|p| p.t).sum::<f64>() / cloud.len().max(1) as f64;
+    (prediction.w_target.norm() * (scan.end_s - mean_t)).to_degrees()
 }
 
 /// Why a frame carried no measurement, and what is known of it.
@@ -149,6 +162,8 @@ impl Tracker {
             .then(|| self.refit(&cloud, &fitted, &context))
             .flatten();
         let refit = second.is_some();
+        let rigid_lag_deg = (!mode.uses_prediction() && !compensated)
+            .then(|| rigid_lag_deg(&cloud, prediction, scan));
         let (fitted, points_behind, registered) = match second {
             Some((fit, behind, kept)) => (fit, points_behind + behind, kept),
             None => (fitted, points_behind, cloud.len()),
@@ -171,6 +186,7 @@ impl Tracker {
             points_behind,
             refit,
             registration_ms: ms(reg_start),
+            rigid_lag_deg,
         })
     }
 

@@ -3,7 +3,9 @@
 //! the held rotation ([`crate::held_rotation`]), the assessment
 //! ([`crate::assess`]) and the filter, frame after frame.
 
-use crate::assess::{attitude_scaled, held_doubt, inconsistency, published, quality_issues};
+use crate::assess::{
+    attitude_scaled, held_doubt, inconsistency, published, quality_issues, rigid_lag_doubt,
+};
 use crate::config::TrackerConfig;
 use crate::dispatch::{Dispatch, LastPose, ndt_params};
 use crate::error::TrackError;
@@ -225,7 +227,7 @@ impl Tracker {
         let (registration, line) = self.held.follow(scan_end, m.registration);
         let held = HeldAxes::of(&registration, line.map(|c| c.sigma_rad), &prediction);
         let counts = (points.len(), m.points_used);
-        let fitted = (m.mode, m.compensated, m.start_up);
+        let fitted = (m.mode, m.compensated, m.start_up, m.rigid_lag_deg);
         let mut out = self.assess(registration, held, fitted, &prediction, scan_end, counts)?;
         out.fallback = m.fallback;
         out.start_up = m.mode != self.config.mode;
@@ -275,14 +277,13 @@ impl Tracker {
         }
     }
 
-    /// Quality and consistency checks, filter update, status.
-    /// `(points_in, points_used)` are the frame's point counts before and
-    /// after pre-processing.
+    /// Quality and consistency checks, filter update, status; `(points_in,
+    /// points_used)`: the point counts before and after pre-processing.
     fn assess(
         &mut self,
         registration: Registration,
         held: Option<HeldAxes>,
-        (mode, compensated, start_up): (TrackingMode, bool, bool),
+        (mode, compensated, start_up, rigid_lag_deg): (TrackingMode, bool, bool, Option<f64>),
         prediction: &Prediction,
         t: f64,
         (points_in, points_used): (usize, usize),
@@ -309,8 +310,9 @@ impl Tracker {
             .innovation(t, &measured, fused.as_ref())
             .map_or(f64::NAN, |o| o.mahalanobis2);
         let mut reasons = quality_issues(&self.config, &registration);
-        reasons.extend(held_doubt(&self.config.loss, held.as_ref()));
         let loss = &self.config.loss;
+        reasons.extend(held_doubt(loss, held.as_ref()));
+        reasons.extend(rigid_lag_doubt(loss, mode, rigid_lag_deg));
         let limit =
             self.innovations
                 .limit_deg(&loss.innovation, loss.max_innovation_rot_deg, start_up);
