@@ -3,8 +3,9 @@
 //! on the recorded frames and no frame is dropped, every pose is the
 //! recorded pose bit for bit, with the recorded status unless init's
 //! confirmation landed on another frame (`unconfirmed` against `tracking`
-//! only); every difference is named with its reason. Offline tracking of the same file is bit-identical run to
-//! run (`tools/spacepose/tests/track_cli.rs`).
+//! only); every difference is named with its reason. Offline tracking of
+//! the same file is bit-identical run to run
+//! (`tools/spacepose/tests/track_cli.rs`).
 #![allow(clippy::unwrap_used)] // test helpers
 
 use serde_json::Value;
