@@ -90,18 +90,10 @@ pub fn covariance_from_information(
     information: &Matrix6<f64>,
 ) -> Result<Matrix6<f64>, FilterError> {
     let what = "registration information matrix";
-    if !information.iter().all(|v| v.is_finite()) {
-        return Err(FilterError::NonFinite { what });
-    }
-    if (information - information.transpose()).abs().max() > 1e-9 * information.abs().max() {
-        return Err(FilterError::NotPositiveDefinite { what });
-    }
-    let sym = (information + information.transpose()) * 0.5;
-    let chol = sym
+    let chol = checked_symmetric(information, what)?
         .cholesky()
         .ok_or(FilterError::NotPositiveDefinite { what })?;
-    let inv = chol.inverse();
-    let inv = (inv + inv.transpose()) * 0.5;
+    let inv = symmetrize(&chol.inverse());
     if !inv.iter().all(|v| v.is_finite()) {
         return Err(FilterError::NotPositiveDefinite { what });
     }
@@ -113,9 +105,9 @@ pub(crate) fn symmetrize<const D: usize>(m: &SMatrix<f64, D, D>) -> SMatrix<f64,
     (m + m.transpose()) * 0.5
 }
 
-/// Checks that a covariance is finite, symmetric (to a relative 1e-9) and
-/// positive definite; returns its symmetrised copy.
-pub(crate) fn checked_covariance<const D: usize>(
+/// Checks that a matrix is finite and symmetric (to a relative 1e-9);
+/// returns its symmetrised copy.
+fn checked_symmetric<const D: usize>(
     m: &SMatrix<f64, D, D>,
     what: &'static str,
 ) -> Result<SMatrix<f64, D, D>, FilterError> {
@@ -125,7 +117,16 @@ pub(crate) fn checked_covariance<const D: usize>(
     if (m - m.transpose()).abs().max() > 1e-9 * m.abs().max() {
         return Err(FilterError::NotPositiveDefinite { what });
     }
-    let s = symmetrize(m);
+    Ok(symmetrize(m))
+}
+
+/// Checks that a covariance is finite, symmetric (to a relative 1e-9) and
+/// positive definite; returns its symmetrised copy.
+pub(crate) fn checked_covariance<const D: usize>(
+    m: &SMatrix<f64, D, D>,
+    what: &'static str,
+) -> Result<SMatrix<f64, D, D>, FilterError> {
+    let s = checked_symmetric(m, what)?;
     s.cholesky()
         .ok_or(FilterError::NotPositiveDefinite { what })?;
     Ok(s)

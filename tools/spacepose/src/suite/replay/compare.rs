@@ -70,18 +70,15 @@ fn by_key(poses: &[TelemetryPose]) -> BTreeMap<Key, &TelemetryPose> {
 /// The frames on which each instance's track left `unconfirmed` (the
 /// confirmation landed, or the track was lost or restarted).
 fn confirmations(poses: &BTreeMap<Key, &TelemetryPose>) -> Vec<(String, u64)> {
-    let mut out = Vec::new();
-    let mut previous: Option<&Key> = None;
-    for (key, p) in poses {
-        let was_unconfirmed = previous
-            .filter(|k| k.0 == key.0)
-            .is_some_and(|k| poses[k].status == "unconfirmed");
-        if was_unconfirmed && p.status != "unconfirmed" {
-            out.push(key.clone());
-        }
-        previous = Some(key);
-    }
-    out
+    let ordered: Vec<_> = poses.iter().collect();
+    ordered
+        .windows(2)
+        .filter(|w| {
+            let ((before_key, before), (key, now)) = (w[0], w[1]);
+            before_key.0 == key.0 && before.status == "unconfirmed" && now.status != "unconfirmed"
+        })
+        .map(|w| w[1].0.clone())
+        .collect()
 }
 
 fn acquisition_keys(list: &[AcquisitionRecord]) -> Vec<AcquisitionKey> {
