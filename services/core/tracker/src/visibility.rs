@@ -16,10 +16,11 @@
 //! simulator's reflections switched off.
 //!
 //! The test is conservative: a point is dropped only when its range exceeds,
-//! by `tolerance_m`, the *farthest* first-surface range within a
-//! neighbourhood that covers the pose's uncertainty, and a neighbourhood
-//! that reaches past the silhouette keeps every point. It uses the
-//! prediction and the model only, never the truth.
+//! by `tolerance_m`, every first-surface range within a disc about its ray
+//! that covers the pose's uncertainty at the point's depth, and a disc
+//! with no surface (beside the target) keeps it
+//! ([`DepthImage::may_be_surface`]). It uses the prediction and the model
+//! only, never the truth.
 
 use crate::depth_image::DepthImage;
 use crate::error::TrackError;
@@ -35,7 +36,7 @@ use std::collections::HashSet;
 pub struct VisibilityConfig {
     /// Drop the points behind the model's first surface before registration.
     pub enabled: bool,
-    /// How far behind the farthest first surface a point must lie to be
+    /// How far behind every first surface near its ray a point must lie to be
     /// dropped (m). A sensor length, not scaled with the target: it covers
     /// the range noise (σ 2 cm), the echoes that mix two surfaces and land
     /// just behind the first, and a model a few centimetres off, while a
@@ -130,14 +131,15 @@ pub struct Gated {
 struct SurfaceTest {
     image: DepthImage,
     compensation: Option<MotionCompensation>,
-    tolerance_m: f32,
+    margin_m: f64,
+    tolerance_m: f64,
     t_target_sensor: spacepose_geometry::Pose,
     grown_box: Option<(Vector3<f64>, Vector3<f64>)>,
 }
 
 impl SurfaceTest {
-    /// False when the point, carried to the scan end, lies behind the
-    /// farthest first surface near its ray or outside the grown box; a
+    /// False when the point, carried to the scan end, lies behind every
+    /// first surface near its ray or outside the grown box; a
     /// non-finite point is left to the registration, which skips it.
     fn may_be_surface(&self, p: &Point) -> bool {
         let x = p.position();
@@ -154,7 +156,8 @@ impl SurfaceTest {
                 return false;
             }
         }
-        (x.norm() as f32) <= self.image.farthest_first_surface(&x) + self.tolerance_m
+        self.image
+            .may_be_surface(&x, self.margin_m, self.tolerance_m)
     }
 }
 
@@ -230,7 +233,6 @@ impl VisibilityModel {
                 self.spacing_m,
                 self.radius_m,
                 &prediction.pose,
-                self.margin_m(prediction, config),
             )
         } else {
             None
@@ -245,11 +247,13 @@ impl VisibilityModel {
             true => None,
             false => Some(MotionCompensation::from_prediction(prediction)?),
         };
-        let grow = self.margin_m(prediction, config) + config.tolerance_m;
+        let margin_m = self.margin_m(prediction, config);
+        let grow = margin_m + config.tolerance_m;
         let test = SurfaceTest {
             image,
             compensation,
-            tolerance_m: config.tolerance_m as f32,
+            margin_m,
+            tolerance_m: config.tolerance_m,
             t_target_sensor: prediction.pose.inverse(),
             grown_box: config.outside_box.then(|| {
                 (
