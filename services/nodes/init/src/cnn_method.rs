@@ -106,6 +106,48 @@ pub(crate) fn resolve_model_dir(dir: &Path) -> PathBuf {
     }
 }
 
+/// The directory of a built-in target's committed model, `rel` (relative
+/// to a source tree's root, e.g. `services/core/cnn/models/deos`), found
+/// by its `model.json` in the first of: the working directory and its
+/// ancestors (a user in the checkout or below it), the executable's
+/// directory's ancestors (`target/release/spacepose` of a checkout run from
+/// anywhere), and the source tree the binary was built from.
+///
+/// Decision: look beside the user and the binary before the compile-time
+/// path, because a binary outlives its build tree (a build cache shared by
+/// several checkouts bakes in whichever one compiled it, and a deleted
+/// checkout left the suite without its CNN with only a warning).
+///
+/// `Err` names every place looked at.
+pub(crate) fn find_committed_model(rel: &Path) -> Result<PathBuf, String> {
+    let mut roots: Vec<PathBuf> = Vec::new();
+    if let Ok(cwd) = std::env::current_dir() {
+        roots.extend(cwd.ancestors().map(Path::to_path_buf));
+    }
+    if let Ok(exe) = std::env::current_exe()
+        && let Some(dir) = exe.parent()
+    {
+        roots.extend(dir.ancestors().map(Path::to_path_buf));
+    }
+    roots.push(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../.."));
+    let candidates: Vec<PathBuf> = roots.iter().map(|r| r.join(rel)).collect();
+    candidates
+        .iter()
+        .find(|d| d.join("model.json").is_file())
+        .cloned()
+        .ok_or_else(|| {
+            format!(
+                "no {} in the working directory, the executable's or the build tree's \
+                 ancestors ({} places, the build tree's {})",
+                rel.display(),
+                candidates.len(),
+                candidates
+                    .last()
+                    .map_or(String::new(), |c| c.display().to_string()),
+            )
+        })
+}
+
 fn build_error(reason: String) -> InitError {
     InitError::Build {
         method: AcquisitionMethod::Cnn.as_str(),
@@ -177,5 +219,21 @@ impl PoseAcquirer for CnnMethod {
                 t.refinement
             ),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::find_committed_model;
+    use std::path::Path;
+
+    #[test]
+    fn the_committed_model_is_found_and_a_missing_one_named() {
+        let deos = find_committed_model(Path::new("services/core/cnn/models/deos")).unwrap();
+        assert!(deos.join("model.json").is_file(), "{deos:?}");
+        let why =
+            find_committed_model(Path::new("services/core/cnn/models/no-such-target")).unwrap_err();
+        assert!(why.contains("models/no-such-target"), "{why}");
+        assert!(why.contains("build tree"), "{why}");
     }
 }

@@ -2,7 +2,7 @@
 //! `deploy/examples/init.toml`), and the method chain it describes.
 
 use crate::chain::MethodChain;
-use crate::cnn_method::{CnnMethod, CnnMethodConfig, resolve_model_dir};
+use crate::cnn_method::{CnnMethod, CnnMethodConfig, find_committed_model, resolve_model_dir};
 use crate::error::InitError;
 use crate::method::PoseAcquirer;
 use crate::state::InitConfig;
@@ -195,7 +195,9 @@ impl InitServiceConfig {
     /// - else the package's own model (`DIR/cnn`, written by
     ///   `spacepose train --target DIR`);
     /// - else, for a built-in target, its model committed in the source
-    ///   tree (`services/core/cnn/models/<name>`).
+    ///   tree (`services/core/cnn/models/<name>`), looked for beside the
+    ///   working directory, the executable and the build tree
+    ///   ([`find_committed_model`]).
     ///
     /// `Err(why)` when there is no model for this target, or the model
     /// found was trained for another one: template matching then acquires
@@ -204,18 +206,16 @@ impl InitServiceConfig {
         let name = package.target.name();
         let dir = match &self.cnn.model_dir {
             Some(dir) => resolve_model_dir(dir),
-            None => package
-                .cnn_dir()
-                .or_else(|| {
-                    let committed = Path::new("services/core/cnn/models").join(name);
-                    let dir = resolve_model_dir(&committed);
-                    dir.join("model.json").is_file().then_some(dir)
-                })
-                .ok_or_else(|| {
-                    "the package has no model; `spacepose train --target DIR` trains one into \
-                     a package directory"
-                        .to_string()
-                })?,
+            None => match package.cnn_dir() {
+                Some(dir) => dir,
+                None => find_committed_model(&Path::new("services/core/cnn/models").join(name))
+                    .map_err(|why| {
+                        format!(
+                            "the package has no model, and there is {why}; `spacepose train \
+                             --target DIR` trains one into a package directory"
+                        )
+                    })?,
+            },
         };
         match ModelMeta::read(&dir) {
             Ok(meta) if meta.target != name => Err(format!(
