@@ -90,15 +90,18 @@ impl CnnMethodConfig {
     }
 }
 
+/// The root of the source tree this crate was compiled from.
+fn source_tree() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../..")
+}
+
 /// `dir` itself when it exists or is absolute, else `dir` under the source
 /// tree's root when it exists there, else `dir` (whose error names it).
 pub(crate) fn resolve_model_dir(dir: &Path) -> PathBuf {
     if dir.is_absolute() || dir.exists() {
         return dir.to_path_buf();
     }
-    let in_tree = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../..")
-        .join(dir);
+    let in_tree = source_tree().join(dir);
     if in_tree.exists() {
         in_tree
     } else {
@@ -129,7 +132,7 @@ pub(crate) fn find_committed_model(rel: &Path) -> Result<PathBuf, String> {
     {
         roots.extend(dir.ancestors().map(Path::to_path_buf));
     }
-    roots.push(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../.."));
+    roots.push(source_tree());
     let candidates: Vec<PathBuf> = roots.iter().map(|r| r.join(rel)).collect();
     candidates
         .iter()
